@@ -4312,6 +4312,25 @@ def test_the_red_kind_of_every_colour_is_the_twins():
     assert (want == 1).any() and (want == 2).any()
 
 
+def test_the_red_pixels_of_every_colour_are_the_twins():
+    """:func:`_jit.red_pixels` on every red level with green and blue on a grid of 0-255 (and equal to red, one below
+    it), the image whole, a strided window of it and a black one: the numpy twin's weak and strong pixels, in the same
+    order; some of each kind, and none of them only where the image is black (stop 65)."""
+    from symfruit.segment.colour import SegmentSettings, _red_pixels
+
+    s = SegmentSettings()
+    levels = np.unique(np.concatenate((np.arange(0, 256, 15), [1, 2, 41, 254, 255])))
+    r, g, b = np.meshgrid(np.arange(256), levels, levels, indexing="ij")
+    image = np.stack((r, g, b), axis=-1).reshape(256, -1, 3).astype(np.uint8)
+    image[:, :2] = np.stack((np.arange(256), np.arange(256), np.maximum(np.arange(256) - 1, 0)), -1)[:, None]
+    for c in (image, image[3:-5, 7:-2], np.zeros((4, 5, 3), np.uint8)):
+        with pytest.MonkeyPatch.context() as mp:
+            (weak, strong), (weak_twin, strong_twin) = _both(mp, _red_pixels, c, s)
+        np.testing.assert_array_equal(weak, weak_twin)
+        np.testing.assert_array_equal(strong, strong_twin)
+        assert (len(weak) > len(strong) > 0) == (c.any())
+
+
 def test_the_reflected_index_is_scipys_reflect_mode():
     """:func:`_jit._reflected` for lines of 1-6 values and indices from three lines before to three after: numpy's
     "symmetric" padding (scipy's "reflect": the edge value repeated) of the line's own indices, inside the line the

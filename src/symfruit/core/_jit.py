@@ -4397,6 +4397,42 @@ def _band_walk(cand: np.ndarray, mine: np.ndarray, count: int, band: int, hidden
                                 reached[r, c] = True
                                 queue[end] = r * n + c
                                 end += 1
+    return _band_spread(cand, queue, end, reached, band, hidden, b0, a0, reach)
+
+
+@_njit_inlined
+def _band_walk_listed(cand: np.ndarray, mine: np.ndarray, count: int, band: int, hidden: np.ndarray, b0: int,
+                      a0: int, reach: np.ndarray, at: np.ndarray, n_at: int) -> int:  # fmt: skip
+    """:func:`_band_walk` with the candidates looked for at the flat indices ``at[:n_at]`` (ascending: raster order)
+    alone, a superset of them, not over every pixel of ``cand``: the same walk from the same first step in the same
+    order (stop 65, occl65)."""
+    m, n = cand.shape
+    queue = np.empty(count, np.int64)
+    reached = np.zeros((m, n), np.bool_)
+    end = 0
+    for i in range(n_at):
+        p = at[i]
+        r, c = p // n, p - (p // n) * n
+        if cand[r, c]:
+            for dr in range(-1, 2):
+                rr = r + dr
+                if 0 <= rr < m:
+                    for dc in range(-1, 2):
+                        cc = c + dc
+                        if 0 <= cc < n and mine[rr, cc] and not reached[r, c]:
+                            reached[r, c] = True
+                            queue[end] = r * n + c
+                            end += 1
+    return _band_spread(cand, queue, end, reached, band, hidden, b0, a0, reach)
+
+
+@_njit_inlined
+def _band_spread(cand: np.ndarray, queue: np.ndarray, end: int, reached: np.ndarray, band: int, hidden: np.ndarray,
+                 b0: int, a0: int, reach: np.ndarray) -> int:  # fmt: skip
+    """:func:`_band_walk`'s walk on from its first step (``queue[:end]``, flat indices in ``cand``'s (m, n), each
+    ``reached``): the pixels reached in more steps than their ``reach`` cleared in ``hidden`` at ``(b0, a0)``, their
+    number returned."""
+    m, n = cand.shape
     cleared = 0
     for i in range(end):  # the first step
         r, c = queue[i] // n, queue[i] % n
@@ -4651,47 +4687,65 @@ def _occlusion_pass(
     # pixel lies outside it, so no column's nearest changes); a pixel waits for its nearest point pixel when its
     # seen depth lies in [lo, hi) (read back from ``seen``), not by a map of its own
     lend = np.empty((h, w), np.bool_)
+    own = np.empty((h, w), np.bool_)  # the fruit's own pixels (its mask's and its point pixels)
+    # stop 65 (occl65): the mask's pixels first along each whole row without a branch, then the point pixels' box
+    # alone; a pixel has depth where 0 < y < inf (NaN compares False: math.isfinite(y) and y > 0, the same pixels)
     for r in range(h):
-        inr = p0 <= r < p1
         for c in range(w):
-            o = mask[v0 + r, u0 + c] or (inr and q0 <= c < q1 and math.isfinite(own_z[r - p0, c - q0]))
+            o = mask[v0 + r, u0 + c]
             y = np.float64(depth[v0 + r, u0 + c])
-            lend[r, c] = not o and math.isfinite(y) and y > 0.0
-            if o:
-                hidden[r, c] = False
-                seen[r, c] = np.nan
-            else:
-                seen[r, c] = y  # NaN for now where it has no depth of its own (below)
+            own[r, c] = o
+            lend[r, c] = (not o) & (y > 0.0) & (y < np.inf)
+            seen[r, c] = np.nan if o else y  # NaN for now where it has no depth of its own (below)
+        if p0 <= r < p1:
+            for c in range(q0, q1):
+                if math.isfinite(own_z[r - p0, c - q0]):
+                    own[r, c] = True
+                    lend[r, c] = False
+                    seen[r, c] = np.nan
     rows = np.zeros(h, np.bool_)
     # stop 60 (obsv60): each row's first and last waiting column, so that the walk below reads that span alone (it
     # skips every other pixel): the same pixels walked in the same order
     first = np.empty(h, np.int64)
     final = np.empty(h, np.int64)
+    # stop 65 (occl65): a row at a time, its pixels without depth (neither the fruit's nor lending) filled first, from
+    # their first offset with depth, then every pixel's hidden bit and whether it waits decided without a branch
+    # (numba vectorises the loop; the first and last waiting columns a least and a greatest): the fruit's own pixels
+    # are NaN in ``seen`` (never nearer, never waiting) and ``not own`` keeps another fruit's mark off them, so the
+    # same bits as the branches deciding one pixel at a time (NaN: hidden where another fruit's; nearer than ``lo``:
+    # hidden; else not, waiting below ``hi``)
     for r in range(h):
+        holes = False
         for c in range(w):
-            x = seen[r, c]
-            if x != x and (mask[v0 + r, u0 + c] or (p0 <= r < p1 and q0 <= c < q1
-                                                        and math.isfinite(own_z[r - p0, c - q0]))):  # fmt: skip
-                continue  # the fruit's own
-            if not lend[r, c]:
-                x = np.nan
-                for j in range(k):
-                    rr, cc = r + steps[j, 0], c + steps[j, 1]
-                    if 0 <= rr < h and 0 <= cc < w and lend[rr, cc]:  # a pixel with depth: its own, never filled
-                        x = np.float64(depth[v0 + rr, u0 + cc])
-                        break
-                seen[r, c] = x
-            if not math.isfinite(x):  # NaN: never nearer, never behind
-                hidden[r, c] = with_others and others[v0 + r, u0 + c]
-            elif x < lo:
-                hidden[r, c] = True
-            else:
-                hidden[r, c] = False
-                if x < hi:
-                    if not rows[r]:
-                        first[r] = c
-                    final[r] = c
-                    rows[r] = True
+            holes |= (not lend[r, c]) & (not own[r, c])
+        if holes:
+            for c in range(w):
+                if not lend[r, c] and not own[r, c]:
+                    x = np.nan
+                    for j in range(k):
+                        rr, cc = r + steps[j, 0], c + steps[j, 1]
+                        if 0 <= rr < h and 0 <= cc < w and lend[rr, cc]:  # a pixel with depth: its own, never filled
+                            x = np.float64(depth[v0 + rr, u0 + cc])
+                            break
+                    seen[r, c] = x
+        a, b = w, -1
+        if with_others:
+            for c in range(w):
+                x = seen[r, c]
+                hidden[r, c] = (x < lo) | ((x != x) & others[v0 + r, u0 + c] & (not own[r, c]))
+                wait = (x >= lo) & (x < hi)
+                a = min(a, c if wait else w)
+                b = max(b, c if wait else -1)
+        else:
+            for c in range(w):
+                x = seen[r, c]
+                hidden[r, c] = x < lo
+                wait = (x >= lo) & (x < hi)
+                a = min(a, c if wait else w)
+                b = max(b, c if wait else -1)
+        if b >= 0:
+            rows[r] = True
+            first[r], final[r] = a, b
     # nearest()'s column pass (each pixel's nearest point pixel in its column, the upper of two as near), kept for
     # the rows looked at alone and the point pixels' columns alone (q0 to q1: no other column has a nearest row):
     # the nearest at or above by a sweep down, the nearest below by a sweep up, each over the point pixels' rows
@@ -8567,6 +8621,7 @@ def _own_edge_in_box(
     # the candidates (hidden, near the own pixels, neither theirs nor another fruit's) and the past pixels' table
     t_past = np.zeros((m + 1, n + 1), np.int32)
     cand = np.zeros((m, n), np.bool_)
+    at = np.empty(m * n, np.int64)  # stop 65 (occl65): the candidates' flat indices, raster order
     count = 0
     for r in range(m):
         run_p = 0
@@ -8577,6 +8632,7 @@ def _own_edge_in_box(
                 if near:
                     if not mine[r, c] and not (with_others and others[v0 + b0 + r, u0 + a0 + c]):
                         cand[r, c] = True
+                        at[count] = r * n + c
                         count += 1
                 else:
                     run_p += 1
@@ -8587,19 +8643,24 @@ def _own_edge_in_box(
     # pixel lies outside the box)
     wide = nb + 2 * band
     rowmin = np.full((max(mb, 1), max(wide, 1)), np.inf)
-    if mb > 0 and nb > 0:
-        padded = np.full((mb, wide), np.inf)
-        for i in range(mb):
-            for j in range(nb):
-                padded[i, band + j] = box_z[i, j]
-        _row_min(padded, band, rowmin)
+    # stop 65 (occl65): each own depth taken into the 2 band + 1 places of the padded row that reach it, not a padded
+    # copy and van Herk's blocks (a remainder a place); a least is exact in any order (no NaN: +inf or a depth)
+    size = 2 * band + 1
+    for i in range(mb):
+        out = rowmin[i]
+        for j in range(nb):
+            v = box_z[i, j]
+            if v < np.inf:
+                for t in range(j, j + size):
+                    out[t] = min(out[t], v)
     front, r_px, r_m = _support_scale(box_z, r0, r1, c0, c1, focal)
     reach = np.zeros((m, n))
+    listed = count
     count = 0
-    for r in range(m):
-        for c in range(n):
-            if not cand[r, c]:
-                continue
+    for i in range(listed):  # the candidates alone (stop 65), in raster order
+        r = at[i] // n
+        c = at[i] - r * n
+        if True:
             # the band ends: something not hiding the fruit lies just beyond, and nothing hidden runs on past it; with
             # ``supports`` a band that runs on (a support) is cleared too, past the reach the fruit may continue behind
             ends = _box_any(t_free, r, c, band + 1, m, n) and not _box_any(t_past, r, c, band, m, n)
@@ -8617,7 +8678,7 @@ def _own_edge_in_box(
             count += x
     if count == 0:
         return 0
-    return _band_walk(cand, mine, count, band, hidden, b0, a0, reach)
+    return _band_walk_listed(cand, mine, count, band, hidden, b0, a0, reach, at, listed)
 
 
 @_njit
