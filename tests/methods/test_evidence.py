@@ -1328,3 +1328,74 @@ def test_a_lost_rims_bound_reaches_the_least_depth_as_far_as_the_cap_says_prolat
     a, b = fit_sd**-2, (s.depth_ratio_sd * width) ** -2
     assert half.max[2] == pytest.approx((a * (z + reach) + b * (z + width)) / (a + b), rel=1e-9)
     assert least.max[2] < half.max[2] < bounded.max[2]
+
+
+@pytest.mark.parametrize("height", [0.8, 1.3])  # an oblate spheroid (an apple) and a prolate one (a pear, a lemon)
+@pytest.mark.parametrize("tilted", [False, True])
+def test_a_hanging_spheroids_prior_width_is_its_horizontal_diameter(height, tilted):
+    """``prior_axis: gravity``: a spheroid hanging from its stalk (its axis along gravity, the camera's +y for a
+    level camera; a camera rolled 25 deg and pitched 15 deg gives its gravity vector in its own frame) off the
+    optical axis, 70 mm across gravity and ``height`` times that along it: the prior's width (``fuse_depth``'s, at
+    the box centre's distance) is its horizontal diameter, 70 mm, within a pixel's worth, oblate or prolate alike,
+    where the widths' geometric mean is the middle of 70 mm and its height (the default, ``prior_axis: mean``)."""
+    from symfruit import Box
+    from symfruit.core.raster import Silhouette, across_sight, width_across
+    from symfruit.methods.evidence import Combined, fuse_depth
+    from symfruit.synthetic.render import render
+    from symfruit.synthetic.shapes import _revolve
+
+    cam = DEFAULT_CAMERA
+    t = np.linspace(0, np.pi, 90)
+    spheroid = _revolve(0.035 * np.sin(t), -0.035 * height * np.cos(t), name="spheroid", n_phi=96)  # axis: y
+    turn = rotation(15, 0, 25) if tilted else np.eye(3)  # the camera's roll and pitch: gravity in its frame
+    gravity = turn @ np.array([0.0, 1.0, 0.0])
+    centre = np.array([0.06, -0.04, 0.45])
+    posed = spheroid.transformed(turn @ rotation(0, 37, 0), centre)  # any turn about its own axis
+    shot = render([(posed.vertices, posed.faces)], cam)
+    rows, cols = np.nonzero(shot.ids == 0)
+    mask = np.zeros((np.ptp(rows) + 1, np.ptp(cols) + 1), bool)
+    mask[rows - rows.min(), cols - cols.min()] = True
+    region = Silhouette(int(cols.min()), int(rows.min()), mask, 0.0)
+    across = across_sight(region, cam)
+    box = Box(centre - 0.035, centre + 0.035)
+    cand = Candidate("cone", box.min, box.max, None, box.centre, 0.002)
+    combined = Combined(box, {"cone": 1.0}, {"cone": 0.0}, 1.0, 0.0, 1.0, 1.0, 0.0)
+    level = width_across(region, across, cam, gravity)
+    widths = {}
+    for axis in ("mean", "gravity"):
+        s = EvidenceSettings(prior_axis=axis, gravity_x=gravity[0], gravity_y=gravity[1], gravity_z=gravity[2])
+        widths[axis] = fuse_depth(combined, [cand], region, cam, s=s, across=across,
+                                  level=level if axis == "gravity" else None)[2]  # fmt: skip
+    pixel = centre[2] / cam.fx
+    assert widths["gravity"] == pytest.approx(0.07, abs=2.0 * pixel)
+    assert widths["mean"] == pytest.approx(0.07 * np.sqrt(height), abs=2.0 * pixel)  # 3-5 mm off
+    assert abs(widths["mean"] - 0.07) > 3.0 * pixel
+
+
+def test_the_prior_axis_setting_reaches_the_prior_and_is_checked():
+    """``complete`` with ``prior_axis: gravity`` reads a hanging oblate spheroid's prior width (``extras["width"]``)
+    as its horizontal diameter, 70 mm, where the default reads the geometric mean (61 mm); on a cut outline (a leaf
+    over its lower third) the setting reads the mean as the default does (a cut takes the width across it, and a
+    leaf over a fruit's side the width across gravity); a zero gravity vector is refused."""
+    from symfruit.core.occlusion import occlusion
+    from symfruit.synthetic.shapes import _revolve
+
+    from ..conftest import occluded_view
+
+    t = np.linspace(0, np.pi, 90)
+    spheroid = _revolve(0.035 * np.sin(t), -0.035 * 0.75 * np.cos(t), name="spheroid", n_phi=96)
+    visible, depth, mask, _posed = occluded_view(spheroid, [0.02, 0.0, 0.4], below=10_000, occluder_z=0.35,
+                                                noise=0.002, seed=2)  # fmt: skip
+    occ = occlusion(depth, mask, visible, DEFAULT_CAMERA)
+    mean = complete(visible, occlusion=occ)
+    level = complete(visible, occlusion=occ, settings=Settings().replace(evidence={"prior_axis": "gravity"}))
+    assert level.extras["width"] == pytest.approx(0.07, abs=0.002)
+    assert mean.extras["width"] == pytest.approx(0.07 * np.sqrt(0.75), abs=0.002)
+    cut = occluded_view(spheroid, [0.02, 0.0, 0.4], below=DEFAULT_CAMERA.cy + 25, occluder_z=0.35, noise=0.002, seed=2)
+    occ = occlusion(cut[1], cut[2], cut[0], DEFAULT_CAMERA)
+    gravity = Settings().replace(evidence={"prior_axis": "gravity"})
+    seen = complete(cut[0], occlusion=occ, settings=gravity)
+    assert seen.extras["contour"] < EvidenceSettings().covered_contour
+    assert seen.extras["width"] == complete(cut[0], occlusion=occ).extras["width"]
+    with pytest.raises(ConfigError):
+        Settings().replace(evidence={"gravity_y": 0.0})

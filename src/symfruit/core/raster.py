@@ -49,6 +49,7 @@ __all__ = [
     "silhouette",
     "silhouette_cone",
     "silhouette_coverage",
+    "width_across",
 ]
 
 # MAX_WINDOW_PIXELS (.limits): the largest image window one fruit may cover, 2000 x 2000, far more than any
@@ -710,6 +711,38 @@ def tangent_extent(points: np.ndarray, across: Across, camera: Camera) -> tuple[
     r = camera.rays(pts[:, 0], pts[:, 1]).reshape(-1, 3)
     t = (r @ across.basis.T) / (r @ across.axis)[:, None]
     return t.min(axis=0), t.max(axis=0)
+
+
+def width_across(region: Silhouette, across: Across, camera: Camera, gravity: np.ndarray) -> float | None:
+    """The region's width across ``gravity`` (a camera-frame vector, REP-103: a level camera's is ``(0, 1, 0)``)
+    in ``across``' tangent units (times the distance: metres): its outline's extent along the direction across the
+    line of sight and across gravity (``axis x gravity``, horizontal), as :func:`across_sight` reads its widths;
+    None where gravity lies along the line of sight (within a degree: a fruit seen from straight above or below).
+
+    A fruit hanging from its stalk is (near) a solid of revolution about the vertical, so it is as deep along a
+    level line of sight as it is wide across gravity, oblate or prolate alike (issue 18, docs/hang65.md).
+
+    >>> cam = Camera(fx=500.0, fy=500.0, cx=50.0, cy=50.0, width=100, height=100)
+    >>> m = np.zeros((100, 100), bool); m[40:60, 45:55] = True
+    >>> a = across_sight(Silhouette(0, 0, m, 0.0), cam)
+    >>> down = np.array([0.0, 1.0, 0.0])
+    >>> round(width_across(Silhouette(0, 0, m, 0.0), a, cam, down) * 500, 3)
+    10.0
+    >>> round(width_across(Silhouette(0, 0, m, 0.0), a, cam, np.array([1.0, 0.0, 0.0])) * 500, 3)
+    20.0
+    >>> width_across(Silhouette(0, 0, m, 0.0), a, cam, np.array([0.0, 0.0, 1.0])) is None
+    True
+    """
+    g = np.asarray(gravity, dtype=np.float64).reshape(3)
+    d = cross_rows(across.axis, g)
+    norm = float(np.linalg.norm(d))
+    if norm <= math.sin(math.radians(1.0)) * float(np.linalg.norm(g)):
+        return None
+    c = across.basis @ (d / norm)  # the direction in tangent coordinates (e1, e2): a unit vector in their plane
+    pts = outline_cracks(region)
+    r = camera.rays(pts[:, 0], pts[:, 1]).reshape(-1, 3)
+    t = (r @ across.basis.T) / (r @ across.axis)[:, None]
+    return float(np.ptp(t @ c))
 
 
 def _image_cone(conic: np.ndarray, centre: np.ndarray, camera: Camera) -> tuple[np.ndarray, np.ndarray]:

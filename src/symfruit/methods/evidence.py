@@ -78,6 +78,7 @@ from ..core.raster import (
     silhouette,
     silhouette_cone,
     tangent_extent,
+    width_across,
 )
 from ..settings import Section, SettingError, setting
 from .paper import PaperSettings
@@ -275,6 +276,19 @@ class EvidenceSettings(Section):
         ``tilt_floor``: the least ``(major^2 - minor^2) / major^2`` the midline's slope is divided by
         (:meth:`~symfruit.core.raster.Tilt.half_depths`: a near-round outline says little of the tilt; 0.3, the
         measured variant: 0.05 put the D435 model's proxies at 4.30 mm against 4.06).
+    prior_axis, gravity_x, gravity_y, gravity_z : {"mean", "gravity"}, float, float, float
+        Which width of the outline the prior reads (issue 18, stop 65, docs/hang65.md). ``mean`` (the default): the
+        geometric mean of its widths across and along its principal axis. ``gravity``: its width across gravity
+        (:func:`~symfruit.core.raster.width_across`, the camera-frame vector ``(gravity_x, gravity_y, gravity_z)``,
+        REP-103's optical frame: ``(0, 1, 0)``, the default, is a level camera's down): a fruit hanging from its
+        stalk is (near) a solid of revolution about the vertical, as deep along a level line of sight as it is wide
+        across gravity, oblate (an apple: its larger width) or prolate (a pear: its smaller) alike. Read on a whole
+        outline only (at least ``covered_contour`` of it a contour): a cut takes most off the width across it, and a
+        leaf over a fruit's side takes the width across gravity itself (the real spheres' ``leafside5-cut`` boxes 22
+        mm too shallow when a cut outline read it); there the mean stands. The width is held within the outline's two
+        principal widths, and ``lost_rim: least`` and ``cap`` read it as their least too. Where gravity lies along
+        the line of sight (within a degree), or ``prior_tilt`` reads a tilt, that reading stands. Off by default:
+        docs/hang65.md.
     tilt_outline, tilt_blocks, tilt_bend : {"points", "mask", "both"}, int, bool
         How the tilt is read (stop 46, docs/tilt46.md; none is on by default, as ``prior_tilt`` is not).
         ``tilt_outline``: the points' own outline (``points``), which a time-of-flight camera's lost rim band erodes
@@ -404,6 +418,10 @@ class EvidenceSettings(Section):
     cut_circle: Literal["off", "free"] = setting("free")
     lost_rim: Literal["pull", "bound", "least", "cap"] = setting("bound")
     prior_tilt: Literal["off", "cap", "prolate"] = setting("off")
+    prior_axis: Literal["mean", "gravity"] = setting("mean")
+    gravity_x: float = setting(0.0, ge=-1e6, le=1e6)
+    gravity_y: float = setting(1.0, ge=-1e6, le=1e6)
+    gravity_z: float = setting(0.0, ge=-1e6, le=1e6)
     tilt_floor: float = setting(0.3, gt=0.0, le=1.0)
     tilt_outline: Literal["points", "mask", "both"] = setting("points")
     tilt_blocks: int = setting(0, ge=0, le=64)
@@ -445,6 +463,8 @@ class EvidenceSettings(Section):
             raise SettingError("mirror", f"must be a paper settings section, got {type(self.mirror).__name__}")
         if self.revolution_points > self.fit_points:
             raise SettingError("revolution_points", "must be <= fit_points")
+        if self.gravity_x == 0.0 and self.gravity_y == 0.0 and self.gravity_z == 0.0:
+            raise SettingError("gravity_y", "gravity (gravity_x, gravity_y, gravity_z) must not be zero")
 
 
 @dataclass(frozen=True)
@@ -613,7 +633,8 @@ def _lateral(dist: float, sized: Across, box: Box) -> float:
 
 
 def prior_width(across: Across, contour: float, cut_width: float = 1.0, tilt: Tilt | None = None,
-                prolate: bool = False, floor: float = 0.3, *, least: bool = False) -> float:  # fmt: skip
+                prolate: bool = False, floor: float = 0.3, *, least: bool = False,
+                level: float | None = None) -> float:  # fmt: skip
     """The silhouette's width the depth prior reads (tangent units: times the distance, metres): the geometric
     mean of its widths across and along its principal axis for a whole outline (a solid of revolution is as deep
     as one of them, whichever way its axis lies in the image), moved in log towards the larger by ``cut_width``
@@ -633,11 +654,19 @@ def prior_width(across: Across, contour: float, cut_width: float = 1.0, tilt: Ti
     (by the square of the cut share, twice the mean's exponent). With the seen front's tilt (``tilt``) the depth
     is the tilt's, its own least.
 
+    ``level``: the outline's width across gravity (``prior_axis: gravity``, tangent units,
+    :func:`~symfruit.core.raster.width_across`), held within its two widths, instead of the mean (and of
+    ``least``'s smaller width: a hanging solid of revolution is that deep), moved towards the larger as the mean is.
+
     >>> a = Across(np.zeros(3), np.zeros((2, 3)), np.zeros(2), np.zeros(2), 0.04, 0.09)
     >>> round(prior_width(a, 1.0), 4), round(prior_width(a, 0.0), 4), round(prior_width(a, 0.5), 4)
     (0.06, 0.09, 0.0664)
     >>> round(prior_width(a, 1.0, least=True), 4), round(prior_width(a, 0.0, least=True), 4)
     (0.04, 0.09)
+    >>> round(prior_width(a, 1.0, level=0.09), 4), round(prior_width(a, 1.0, level=0.04, least=True), 4)
+    (0.09, 0.04)
+    >>> round(prior_width(a, 0.5, level=0.04), 4), round(prior_width(a, 1.0, level=0.2), 4)
+    (0.049, 0.09)
     """
     small, big = sorted((float(across.minor), float(across.major)))
     if small <= 0.0:
@@ -648,6 +677,9 @@ def prior_width(across: Across, contour: float, cut_width: float = 1.0, tilt: Ti
         # tangent units, then towards the larger width as the geometric mean is
         half = tilt.half_depths(floor)[0] if prolate else tilt.half_depth(floor)
         depth = min(max(half / tilt.major * big, 0.5 * small), 2.0 * big)
+        return depth * (big / depth) ** cut
+    if level is not None and level > 0.0:
+        depth = min(max(float(level), small), big)
         return depth * (big / depth) ** cut
     return big * (small / big) ** ((1.0 if least else 0.5) * (1.0 - cut))
 
@@ -808,6 +840,7 @@ def fuse_depth(
     faces: tuple[np.ndarray, np.ndarray] | None = None,
     masked: bool = True,
     prolate: float | None = None,
+    level: float | None = None,
 ) -> tuple[Box, float, float]:
     """The box moved towards what the silhouette says: ``(box, back_sd, width)``, metres.
 
@@ -820,7 +853,8 @@ def fuse_depth(
     for the lateral faces. ``masked``: the outline is the fruit's mask's (occlusion information), not the points' own,
     which a lost rim narrows by a band on every side and so more across than along (``lost_rim: least`` reads its
     smaller width only on a mask's outline). ``prolate``: how far the seen cap says prolate, in [0, 1]
-    (``lost_rim: cap``; None: not read, the mean's reach).
+    (``lost_rim: cap``; None: not read, the mean's reach). ``level``: the outline's width across gravity
+    (``prior_axis: gravity``, :func:`prior_width`; None: the mean).
 
     The candidates' back face (the weighted median, :func:`combine`) and the prior ``front + depth_ratio *
     width`` are averaged by their inverse variances (module docstring, step 6); ``back_sd`` is the posterior
@@ -838,10 +872,14 @@ def fuse_depth(
     spread = float((w * np.abs(backs - fit_back)).sum())
     back_std = next((c.back_std for c in cands if c.name == "cone" and math.isfinite(c.back_std)), 0.0)
     across = across_sight(region, camera) if across is None else across
-    width = float(prior_width(across, combined.contour, s.cut_width, tilt, s.prior_tilt == "prolate", s.tilt_floor))
+    width = float(prior_width(across, combined.contour, s.cut_width, tilt, s.prior_tilt == "prolate", s.tilt_floor,
+                              level=level))  # fmt: skip
     read = combined.contour  # the contour share of the outline the prior's width is read from
     if whole is not None:  # the ellipse of the outline's free arcs, as an uncut outline's; a cut only narrows
         ellipse = float(np.sqrt(whole[0] * whole[1]))
+        if level is not None and tilt is None and across.minor > 0:  # across gravity: the whole outline's stretch
+            held = min(max(float(level), across.minor), across.major)  # as prior_width holds it
+            ellipse = held * ellipse / math.sqrt(across.minor * across.major)
         if s.cut_spread == "ellipse" and ellipse > width:
             read = 1.0  # the width is the whole outline's (the ellipse's), not the cut one's
         width = max(width, ellipse)
@@ -850,7 +888,7 @@ def fuse_depth(
         # the least depth the prior allows, read as its width is: on a whole outline (a cut one's smaller width
         # measures the cut, not the fruit; there ``least`` is ``bound``)
         least = float(prior_width(across, combined.contour, s.cut_width, tilt, s.prior_tilt == "prolate",
-                                  s.tilt_floor, least=True))  # fmt: skip
+                                  s.tilt_floor, least=True, level=level))  # fmt: skip
         if whole is not None:
             least = max(least, float(min(whole)))
         if s.lost_rim == "cap":  # the least width as far as the seen cap says prolate, the mean's where oblate
@@ -1046,13 +1084,18 @@ def evidence(
             whole = (sized.minor * stretch, sized.major * stretch)
             if reach is not None and s.cut_faces == "sides" and trimmed is None:  # the region's own outline
                 faces = tangent_extent(reach, sized, camera)
+    level = None
+    if s.prior_axis == "gravity" and obs.contour >= s.covered_contour:  # across gravity, of ``sized``'s outline
+        gravity = np.array([s.gravity_x, s.gravity_y, s.gravity_z])
+        level = width_across(region if trimmed is None else trimmed, sized, camera, gravity)
     prolate = None
     if capped and tilt is not None:  # how far the cap says prolate: 1 at the prolate spheroid's cap, 0 from half-way
         share = tilt.oblate_share(s.tilt_floor)
         prolate = 0.0 if share is None else min(max(1.0 - 2.0 * share, 0.0), 1.0)
     box, back_sd, width = fuse_depth(combined, cands, region, camera, s=s, rim=rim, seen_back=seen_back,
                                      across=sized, tilt=tilt if s.prior_tilt != "off" else None, whole=whole,
-                                     faces=faces, masked=occlusion is not None, prolate=prolate)  # fmt: skip
+                                     faces=faces, masked=occlusion is not None, prolate=prolate,
+                                     level=level)  # fmt: skip
     moved = 0.5 * abs(float(box.max[2] - combined.box.max[2]))  # the prior against the shapes
     # A fruit receding along the line of sight (a depth camera's view seen deeper than the half-width a round
     # fruit shows in front of its rim, as far as the outline is a contour) has a back that nothing seen
