@@ -1829,3 +1829,60 @@ def test_no_reading_is_made_where_the_depth_around_the_box_decides():
     assert whole is not None and alone is not None
     assert whole.front == pytest.approx(0.50, abs=0.005) and alone.front == pytest.approx(0.46, abs=0.002)
     assert not read
+
+
+# --- reg65: the registration search's bookkeeping without numpy's generic helpers (issue 19, stop 65)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_search_grids_pairs_are_meshgrids_in_its_order(seed):
+    """``_pairs(v, u)`` is ``np.stack(np.meshgrid(v, u, indexing="ij"), axis=-1).reshape(-1, 2)`` (int64): the grids
+    of shifts :func:`registration_search` costs, in the same order (the first least is taken)."""
+    from symfruit.core.surface import _pairs
+
+    rng = np.random.default_rng(seed)
+    v = rng.integers(-30, 31, size=int(rng.integers(1, 12)))
+    u = rng.integers(-30, 31, size=int(rng.integers(1, 12)))
+    got = _pairs(v, u)
+    assert got.dtype == np.int64
+    np.testing.assert_array_equal(got, np.stack(np.meshgrid(v, u, indexing="ij"), axis=-1).reshape(-1, 2))
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_told_axes_are_the_share_tests_on_the_sides_array(seed):
+    """``_told_axes`` on Python's whole numbers: numpy's tests on the (4, 2) array (a side free when more than
+    ``_FREE_SHARE`` of its points are), free counts at, just below and just above the share."""
+    from symfruit.core.surface import _FREE_SHARE, _told_axes
+
+    rng = np.random.default_rng(seed)
+    n = rng.integers(0, 40, size=4)
+    f = np.clip(np.floor(_FREE_SHARE * n).astype(np.int64) + rng.integers(-1, 2, size=4), 0, n)
+    sides = np.stack([f, n], axis=1)
+    free = sides[:, 0] > _FREE_SHARE * sides[:, 1]
+    got = _told_axes(sides)
+    assert got == (bool(free[0] and free[1]), bool(free[2] and free[3]))
+    assert all(type(x) is bool for x in got)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_frame_costs_order_is_the_stable_argsorts(seed):
+    """``_FrameCosts``' order of the outlines (fewest points first, ties in the frame's order; after the first, those
+    telling one axis alone): the stable argsort's and the masks of it, many ties of length."""
+    from symfruit.core.surface import _FrameCosts, _Outline
+
+    rng = np.random.default_rng(seed)
+    outlines = []
+    for _ in range(int(rng.integers(1, 10))):
+        m = int(rng.integers(12, 15))
+        sides = np.stack([rng.integers(0, 11, size=4), np.full(4, 10)], axis=1)
+        outlines.append(_Outline(np.zeros(m, np.int64), np.zeros(m, np.int64), np.zeros((4, 4)), 1.0, sides))
+    order = np.argsort([len(o.rows) for o in outlines], kind="stable")
+    rest = order[1:]
+    one_axis = np.array([not all(outlines[i].axes) for i in rest], bool)
+    expected = np.concatenate([order[:1], rest[one_axis], rest[~one_axis]]).astype(np.int64)
+    got = _FrameCosts(outlines, 5, 0.7).order  # the numpy stages: the order alone is made
+    assert got.dtype == np.int64
+    np.testing.assert_array_equal(got, expected)

@@ -1655,12 +1655,16 @@ def _sort_rows(keys: np.ndarray) -> np.ndarray:
 
 
 def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_points: int = 160, *,
-             clean: bool = False, occluders: bool = False) -> _Outline | None:  # fmt: skip
+             clean: bool = False, occluders: bool = False, count: int | None = None) -> _Outline | None:  # fmt: skip
     """The free points of the outline of a fruit's depth cap found around its mask (``reach`` pixels beyond it),
     and how many of each side's points are free (:func:`_free_points`), or None (fewer than 12 free points).
     ``clean``: :func:`fruit_surface`'s (the depth finite, above 0 or 0 already). ``occluders``: a lost band beside
-    something in front is a junction (:func:`_free_points`' ``tol``, ``extract.occluder_edges``; stop 62)."""
-    jit = compiled() if mask.dtype == bool and mask.ndim == 2 and mask.any() and not mask.all() else None
+    something in front is a junction (:func:`_free_points`' ``tol``, ``extract.occluder_edges``; stop 62).
+    ``count``: ``np.count_nonzero(mask)`` of a bool mask when the caller has it (:func:`registration_outline`)."""
+    if count is None or mask.dtype != bool:
+        count = int(np.count_nonzero(mask))
+    # a bool mask holding pixels of both kinds: 0 < count < size (stop 65, reg65: without mask.any() and mask.all())
+    jit = compiled() if mask.dtype == bool and mask.ndim == 2 and 0 < count < mask.size else None
     found: tuple[bool, np.ndarray, np.ndarray, np.ndarray] | None = None
     inside: np.ndarray | None = None
     if jit is not None:  # the grown window, both distance maps, the keys and their ranks in one call (stop 50)
@@ -1699,7 +1703,7 @@ def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_
     step = max(1, len(rows) // max_points)
     if inside is None:
         inside = inner - distance_transform(~mask)
-    outline = _Outline(rows[::step], cols[::step], inside, 0.3 * float(np.sqrt(np.count_nonzero(mask) / np.pi)), sides)
+    outline = _Outline(rows[::step], cols[::step], inside, 0.3 * float(np.sqrt(count / np.pi)), sides)
     if found is not None and found[0]:  # the keys and ranks of the costs' pad (the search's shifts are within reach)
         outline._padded[("keys", int(reach), int(reach))] = found[1]
         outline._ranks[(int(reach), int(reach))] = (found[2], found[3])
@@ -1842,8 +1846,9 @@ def _told_axes(sides: np.ndarray) -> tuple[bool, bool]:
     axis is told apart from the band only by both sides of that axis: with the bottom side missing, moving the
     masks down and widening the band at the top are one and the same (a fruit on a board: no band at the bottom,
     where the board runs on; a wide band at the top, mixed pixels against the far background)."""
-    free = sides[:, 0] > _FREE_SHARE * sides[:, 1]
-    return bool(free[0] and free[1]), bool(free[2] and free[3])
+    # as Python's whole numbers (stop 65, reg65: numpy's tests on the (4, 2) array, a few us less an outline)
+    (f0, n0), (f1, n1), (f2, n2), (f3, n3) = sides.tolist()
+    return f0 > _FREE_SHARE * n0 and f1 > _FREE_SHARE * n1, f2 > _FREE_SHARE * n2 and f3 > _FREE_SHARE * n3
 
 
 def _taxicab_within(mask: np.ndarray, reach: int) -> np.ndarray:
@@ -1934,7 +1939,7 @@ def registration_outline(depth: np.ndarray, mask: np.ndarray, focal: float, *, m
     found in any order, or on several processes (:class:`~symfruit.fruitpool.FruitPool`), with the same values;
     :func:`registration_search` takes them in the frame's order."""
     lo, hi = depth_range
-    if np.count_nonzero(mask) < 30:  # the sum's count (stop 47)
+    if (count := int(np.count_nonzero(mask))) < 30:  # the sum's count (stop 47)
         return None
     # depth made valid in the fruit's window alone (a whole 1920x1080 frame costs milliseconds), in float64 (a
     # float32 frame converted window by window: the same values, without a float64 copy of the whole frame)
@@ -1946,7 +1951,7 @@ def registration_outline(depth: np.ndarray, mask: np.ndarray, focal: float, *, m
     else:
         z = np.where(np.isfinite(z) & (z > 0) & (z >= lo) & (z <= hi), z, 0.0)
     # z is finite, above 0 or 0 (valid_depth's least depth is above 0): fruit_surface reads it as it is (stop 49)
-    found = _outline(z, mask, focal, max_px, clean=True, occluders=occluders)
+    found = _outline(z, mask, focal, max_px, clean=True, occluders=occluders, count=count)
     # with occluders, an outline that tells no axis is kept too: its sides count in the frame's pool
     # (registration_search), though it costs no shift (stop 62, docs/leaf62.md)
     return found if found is not None and (occluders or any(found.axes)) else None
@@ -1963,7 +1968,8 @@ def registration_search(outlines: list[_Outline], *, max_px: int, trim: float = 
     # in front does not leave one outline, perhaps the leaf's own, to decide it; stop 62) and a fruit tells it;
     # otherwise it keeps 0
     counted = [o.sides for o in outlines if o.sides is not None]
-    pooled = _told_axes(np.sum(counted, axis=0)) if counted else (True, True)
+    # the sides summed one outline after another (whole numbers: np.sum's, without its array of the list)
+    pooled = _told_axes(functools.reduce(np.add, counted)) if counted else (True, True)
     outlines = [o for o in outlines if any(o.axes)]  # the outlines that cost shifts
     if not outlines:
         return 0, 0
@@ -1978,13 +1984,11 @@ def registration_search(outlines: list[_Outline], *, max_px: int, trim: float = 
     tell_v, tell_u = (pooled[i] and any(o.axes[i] for o in outlines) for i in (0, 1))
     if not (tell_v or tell_u):
         return 0, 0
-    coarse = np.arange(-max_px, max_px + 1, 2)
-    grid = np.stack(np.meshgrid(coarse if tell_v else [0], coarse if tell_u else [0], indexing="ij"), axis=-1)
-    grid = grid.reshape(-1, 2)
+    coarse, zero = np.arange(-max_px, max_px + 1, 2, dtype=np.int64), np.zeros(1, np.int64)
+    grid = _pairs(coarse if tell_v else zero, coarse if tell_u else zero)
     dv, du = grid[least(grid)]
-    near = np.arange(-2, 3)
-    fine = np.stack(np.meshgrid(dv + (near if tell_v else 0), du + (near if tell_u else 0), indexing="ij"), axis=-1)
-    fine = fine.reshape(-1, 2)
+    near = np.arange(-2, 3, dtype=np.int64)
+    fine = _pairs(dv + near if tell_v else zero + dv, du + near if tell_u else zero + du)
     fine = fine[(np.abs(fine) <= max_px).all(axis=1)]
     best = least(fine)
     if not fine[best].any() or (np.abs(fine[best]) >= max_px).any():
@@ -2002,6 +2006,17 @@ def registration_search(outlines: list[_Outline], *, max_px: int, trim: float = 
     if no_gain:
         return 0, 0
     return int(fine[best, 1]), int(fine[best, 0])
+
+
+def _pairs(v: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """(len(v) * len(u), 2) int64: every ``(v[i], u[j])``, ``i`` the slower, of two 1-D whole-number arrays:
+    ``np.stack(np.meshgrid(v, u, indexing="ij"), axis=-1).reshape(-1, 2)`` (:func:`registration_search`'s grids of
+    shifts), written in two assignments (stop 65, reg65: the same pairs in the same order, without meshgrid's and
+    stack's Python, some 20 us a grid)."""
+    out = np.empty((len(v), len(u), 2), np.int64)
+    out[:, :, 0] = v[:, None]
+    out[:, :, 1] = u[None, :]
+    return out.reshape(-1, 2)
 
 
 def _no_gain(at_best: float, zero: float, gain: float) -> bool | None:
@@ -2043,10 +2058,11 @@ class _FrameCosts:
         # row of the costs, so their means are the same numbers whatever the order. After the first, the outlines
         # that tell one axis alone (stop 48): each costs at most one shift per value of that axis however many
         # shifts are left, so it prunes the later ones at next to no cost of its own
-        order = np.argsort([len(o.rows) for o in outlines], kind="stable")
+        # (Python's sort is stable, as the argsort it stands for: stop 65, reg65)
+        order = sorted(range(len(outlines)), key=lambda i: len(outlines[i].rows))
         rest = order[1:]
-        one_axis = np.array([not all(outlines[i].axes) for i in rest], bool)
-        self.order = np.concatenate([order[:1], rest[one_axis], rest[~one_axis]]).astype(np.int64)
+        one_axis = [i for i in rest if not all(outlines[i].axes)]
+        self.order = np.array(order[:1] + one_axis + [i for i in rest if all(outlines[i].axes)], np.int64)
         #: :meth:`least`'s fast costs (the outlines' mean) of its last shifts, NaN at those it left out
         self.means = np.empty(0)
         if jit is None:
@@ -2060,8 +2076,8 @@ class _FrameCosts:
             at.append(points)
             widths.append(width)
         self.starts = np.zeros((len(outlines) + 1, 3), np.int64)
-        for i, part in enumerate((ranks, values, at)):
-            np.cumsum([len(x) for x in part], out=self.starts[1:, i])
+        lengths = [(len(r), len(v), len(a)) for r, v, a in zip(ranks, values, at, strict=True)]
+        np.cumsum(lengths, axis=0, out=self.starts[1:])
         self.ranks, self.values, self.at = np.concatenate(ranks), np.concatenate(values), np.concatenate(at)
         self.widths = np.array(widths, np.int64)
         self.keeps = np.array([max(1, int(trim * len(o.rows))) for o in outlines], np.int64)
