@@ -1007,7 +1007,8 @@ def outline_circle(
     # the normal equations about the points' mean: f = -mean(z), and a 2 x 2 system for d, e (no least-squares
     # solver: a tenth of the call's cost where the circle is tried on every cut outline without an ellipse)
     try:
-        found = solve2(float(x @ x), float(x @ y), float(x @ y), float(y @ y), -float(x @ z), -float(y @ z))
+        xy = float(x @ y)  # once for both off-diagonal entries (the same product; stop 65)
+        found = solve2(float(x @ x), xy, xy, float(y @ y), -float(x @ z), -float(y @ z))
     except np.linalg.LinAlgError:  # the points on a line
         return None
     if found is None:
