@@ -499,7 +499,7 @@ def _weighted_median(values: np.ndarray, weights: np.ndarray, *, listed: list[li
     then the first place where the running sum of the weights in that order (added one by one, as ``np.cumsum``
     adds them) reaches half of their sum (``weights.sum()``'s), in Python floats (the same IEEE sums: a few dozen
     additions, where ``np.cumsum`` and two ``np.take_along_axis`` cost some 60 us; issue 19, nineteenth round)."""
-    order = np.argsort(values, axis=0).tolist()
+    order = values.argsort(axis=0).tolist()  # np.argsort's call
     half = float(0.5 * weights.sum())
     w, v = weights.tolist(), values.tolist() if listed is None else listed  # ``listed``: ``values.tolist()``, known
     out = []
@@ -559,12 +559,15 @@ def combine(cands: list[Candidate], *, contour: float, clean: float, s: Evidence
     energies: dict[str, float] = {}
     best_rms = max(min((c.agreement.depth for c in closed if c.agreement is not None), default=1.0), 1e-6)
     cut = s.cut_energy * (1.0 - contour)
+    # the closed candidates' log depth ratios by one np.log of them all (its float64 values, each the scalar call's;
+    # issue 19, stop 65: one ufunc call for one a candidate), in their order
+    logs = iter(np.log(np.array([max(c.agreement.depth, 1e-6) / best_rms for c in closed if c.agreement is not None])))
     for c in cands:
         ev = c.agreement
         if ev is None:
             energies[c.name] = s.mirror_energy if c.name == "mirror" else s.raw_energy + cut
             continue
-        energy = s.depth_weight * np.log(max(ev.depth, 1e-6) / best_rms)
+        energy = s.depth_weight * next(logs)
         energy += s.silhouette_weight * (ev.inside + ev.outside)
         if c.name == "cone":
             # its premise: the seen outline is the fruit's silhouette (or, fitted to its contour part, that part)
@@ -587,7 +590,8 @@ def combine(cands: list[Candidate], *, contour: float, clean: float, s: Evidence
     spread = _spread(rows, w, box)
     wrong = min((c.agreement.inside + c.agreement.outside for c in closed if c.agreement is not None),
                 default=2.0)  # fmt: skip
-    size = float(box.size.max())
+    (l0, l1, l2), (h0, h1, h2) = box.min.tolist(), box.max.tolist()
+    size = max(h0 - l0, h1 - l1, h2 - l2)  # float(box.size.max()): the same differences, finite (a Box's)
     back_std = next((c.back_std for c in cands if c.name == "cone" and math.isfinite(c.back_std)), 0.0)
     uncertainty = float(np.hypot(back_std, spread) + s.misfit_scale * wrong * size)
     confidence = float(np.exp(-uncertainty / s.uncertainty_scale))
@@ -685,7 +689,9 @@ def hidden_front(sample: np.ndarray, front: float, width: float, occlusion: Occl
     z, at = sphere_front(sample, 0.5 * diameter, tolerance=FRONT_TOLERANCE)
     if not (np.isfinite(z) and 0.0 < z < front):
         return front
-    u, v = camera.project(at[None, :])[0]
+    ax, ay, az = at.tolist()  # camera.project's (u, v) of ``at`` in Python floats: the same products and sums
+    inv_z = 1.0 / az  # (z > 0 here)
+    u, v = camera.fx * ax * inv_z + camera.cx, camera.fy * ay * inv_z + camera.cy
     uu, vv = np.array([u]), np.array([v])
     if bool(occlusion.at(uu, vv)[0]):
         return front if float(occlusion.depth_at(uu, vv)[0]) > z else z  # seen behind it there: the fruit would be
@@ -831,11 +837,8 @@ def fuse_depth(
     points is as narrow as the cap it saw, and the silhouette is the better measure of the fruit's width too.
     """
     box = combined.box
-    names = [c.name for c in cands]
-    w = np.array([combined.weights[n] for n in names])
-    backs = np.array([c.hi[2] for c in cands])
     fit_back = float(box.max[2])
-    spread = float((w * np.abs(backs - fit_back)).sum())
+    spread = _back_spread(cands, combined.weights, fit_back)
     back_std = next((c.back_std for c in cands if c.name == "cone" and math.isfinite(c.back_std)), 0.0)
     across = across_sight(region, camera) if across is None else across
     width = float(prior_width(across, combined.contour, s.cut_width, tilt, s.prior_tilt == "prolate", s.tilt_floor))
@@ -900,6 +903,22 @@ def fuse_depth(
         widest = max(across.major, across.minor, *(across.hi - across.lo).tolist())
     lo, hi = _lateral_faces(box, sil, front, back, share, pull, widest)
     return Box(np.array(lo), np.array(hi)), 1.0 / math.sqrt(a + b), width
+
+
+def _back_spread(cands: list[Candidate], weights: dict[str, float], fit_back: float) -> float:
+    """``float((w * np.abs(backs - fit_back)).sum())`` of the candidates' weights ``w`` (``weights`` by name) and back
+    faces ``backs`` (``c.hi[2]``): in Python floats where there are fewer than 8 (numpy adds so few values left to
+    right from the first; each difference, absolute value and product IEEE's, as numpy's; issue 19, stop 65: seven
+    numpy calls a fruit), else by numpy."""
+    if len(cands) >= 8 or not cands:
+        w = np.array([weights[c.name] for c in cands])
+        backs = np.array([c.hi[2] for c in cands])
+        return float((w * np.abs(backs - fit_back)).sum())
+    terms = [weights[c.name] * abs(float(c.hi[2]) - fit_back) for c in cands]
+    total = terms[0]
+    for term in terms[1:]:
+        total += term
+    return total
 
 
 def _lateral_faces(box: Box, across: Across, front: float, back: float, share: float, grow: float,
