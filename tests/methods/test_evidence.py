@@ -633,6 +633,21 @@ def test_combines_energies_and_back_spread_are_the_former_numpy_values(seed):
     assert list(got.energies) == list(want)
     for name, energy in want.items():
         assert type(got.energies[name]) is type(energy) and got.energies[name] == energy
+    # the former weights, spread and uncertainty (np.exp of -(e - min) / t, box.centre, box.size.max())
+    from symfruit.core.points import row_norms
+
+    e = np.array([want[c.name] for c in cands])
+    w_former = np.exp(-(e - e.min()) / s.temperature)
+    w_former /= w_former.sum()
+    assert [got.weights[c.name] for c in cands] == w_former.tolist()
+    faces = np.array([c.lo.tolist() + c.hi.tolist() for c in cands])
+    spread = float((w_former * row_norms(0.5 * (faces[:, :3] + faces[:, 3:]) - got.box.centre)).sum())
+    assert got.spread == spread
+    closed = [c.agreement for c in cands if c.agreement is not None]
+    wrong = min((a.inside + a.outside for a in closed), default=2.0)
+    back_std = next((c.back_std for c in cands if c.name == "cone" and np.isfinite(c.back_std)), 0.0)
+    size = float(got.box.size.max())
+    assert got.uncertainty == float(np.hypot(back_std, spread) + s.misfit_scale * wrong * size)
     w = np.array([got.weights[c.name] for c in cands])
     w[rng.random(k) < 0.2] = 0.0
     weights = dict(zip([c.name for c in cands], w.tolist(), strict=True))

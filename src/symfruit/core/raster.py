@@ -1018,7 +1018,8 @@ def outline_circle(
     if not (math.isfinite(r2) and r2 > 0.0):
         return None
     off = np.sqrt((x - cu) ** 2 + (y - cv) ** 2) - math.sqrt(r2)
-    if not float(np.sqrt((off * off).mean())) <= fit_px:
+    mean_square = float((off * off).mean())  # its root by math.sqrt, np.sqrt's (correctly rounded); NaN: refused
+    if not (mean_square >= 0.0 and math.sqrt(mean_square) <= fit_px):
         return None
     centre = np.array([mu[0] + cu, mu[1] + cv])
     if not _credible(region, centre, np.eye(2) / r2, math.pi * r2, inside, max_area):

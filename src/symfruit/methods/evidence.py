@@ -478,15 +478,18 @@ class Combined:
     uncertainty: float
 
 
-def _spread(rows: list[list[float]], w: np.ndarray, box: Box) -> float:
+def _spread(
+    rows: list[list[float]], w: np.ndarray, box: Box, centre: tuple[float, float, float] | None = None
+) -> float:
     """``float((w * row_norms(centres - box.centre)).sum())`` of the candidates' faces ``rows`` (k lists of six
     floats, ``centres`` their ``0.5 * (lo + hi)``): in Python floats where ``k < 8`` (numpy adds so few values left
-    to right; each difference, product and root IEEE's, as numpy's; issue 19, stop 45), else by numpy."""
+    to right; each difference, product and root IEEE's, as numpy's; issue 19, stop 45), else by numpy. ``centre``:
+    ``box.centre.tolist()`` when known (stop 65)."""
     if len(rows) >= 8 or len(rows) != len(w):
         faces = np.array(rows)
         centres = 0.5 * (faces[:, :3] + faces[:, 3:])
         return float((w * row_norms(centres - box.centre)).sum())
-    b0, b1, b2 = box.centre.tolist()
+    b0, b1, b2 = box.centre.tolist() if centre is None else centre
     total = 0.0
     for (l0, l1, l2, h0, h1, h2), wi in zip(rows, w.tolist(), strict=True):
         d0, d1, d2 = 0.5 * (l0 + h0) - b0, 0.5 * (l1 + h1) - b1, 0.5 * (l2 + h2) - b2
@@ -577,7 +580,7 @@ def combine(cands: list[Candidate], *, contour: float, clean: float, s: Evidence
         energies[c.name] = energy
     names = [c.name for c in cands]
     e = np.array([energies[n] for n in names])
-    w = np.exp(-(e - e.min()) / s.temperature)
+    w = np.exp((e - e.min()) / -s.temperature)  # -(x) / t: x / -t to the bit (rounding is symmetric in sign)
     w /= w.sum()
     # each candidate's six faces as Python floats, the array made of them (the same float64 values as joining its
     # float64 lo and hi; one call for one a candidate; issue 19, stop 45)
@@ -587,10 +590,11 @@ def combine(cands: list[Candidate], *, contour: float, clean: float, s: Evidence
     if s.back_trim < 0.5:  # the back face over the middle of the weight (EvidenceSettings.back_trim)
         box_faces[5] = max(midmean(faces[:, 5], w, s.back_trim), float(box_faces[2]) + 1e-4)
     box = Box(box_faces[:3], box_faces[3:])
-    spread = _spread(rows, w, box)
+    (l0, l1, l2), (h0, h1, h2) = box.min.tolist(), box.max.tolist()
+    # box.centre's (lo + hi) / 2 and box.size's differences in Python floats: the same IEEE operations
+    spread = _spread(rows, w, box, ((l0 + h0) / 2.0, (l1 + h1) / 2.0, (l2 + h2) / 2.0))
     wrong = min((c.agreement.inside + c.agreement.outside for c in closed if c.agreement is not None),
                 default=2.0)  # fmt: skip
-    (l0, l1, l2), (h0, h1, h2) = box.min.tolist(), box.max.tolist()
     size = max(h0 - l0, h1 - l1, h2 - l2)  # float(box.size.max()): the same differences, finite (a Box's)
     back_std = next((c.back_std for c in cands if c.name == "cone" and math.isfinite(c.back_std)), 0.0)
     uncertainty = float(np.hypot(back_std, spread) + s.misfit_scale * wrong * size)
@@ -1078,7 +1082,9 @@ def evidence(
     # mirrors; an elongated outline leaves the tilt of the fruit's long axis out of the image unseen. (A
     # sparse cloud's points need not end at the rim: no receding measure there.)
     recede = obs.contour * max(0.0, seen_back - float(box.min[2]) - 0.5 * width) if dense else 0.0
-    elongation = float(np.sqrt(across.major / max(across.minor, 1e-12)))
+    stretched = float(across.major / max(across.minor, 1e-12))
+    # np.sqrt's value: both square roots correctly rounded (numpy's where the ratio is NaN or negative)
+    elongation = math.sqrt(stretched) if stretched >= 0.0 else float(np.sqrt(stretched))
     # What no closed shape explains of the seen depths beyond the sensor's noise: a shape that misses the front
     # it was fitted to does not predict the back it extrapolates (the outline's part is in ``combined``). Not for
     # a sparse cloud, whose points need not be the nearest surface on their rays.
