@@ -13,6 +13,7 @@ from symfruit.evaluate.protocols import Spec, build
 from symfruit.methods.evidence import (
     FRONT_TOLERANCE,
     EvidenceSettings,
+    _back_spread,
     _spread,
     _weighted_median,
     clean_share,
@@ -579,6 +580,85 @@ def test_the_spread_in_python_floats_is_numpys(seed):
     assert type(got) is float and got == want
     two = [[0.0, 0.0, 0.0, 2.0, 2.0, 2.0], [1.0, 1.0, 1.0, 1.0, 5.0, 1.0]]
     assert _spread(two, np.array([0.5, 0.5]), Box(np.zeros(3), np.full(3, 2.0))) == 1.0
+
+
+def _former_energies(cands, contour, clean, s, cone_source):
+    """``combine``'s energies as they were before issue 19, stop 65: one ``np.log`` call per closed candidate."""
+    closed = [c for c in cands if c.agreement is not None]
+    best_rms = max(min((c.agreement.depth for c in closed), default=1.0), 1e-6)
+    cut = s.cut_energy * (1.0 - contour)
+    energies = {}
+    for c in cands:
+        ev = c.agreement
+        if ev is None:
+            energies[c.name] = s.mirror_energy if c.name == "mirror" else s.raw_energy + cut
+            continue
+        energy = s.depth_weight * np.log(max(ev.depth, 1e-6) / best_rms)
+        energy += s.silhouette_weight * (ev.inside + ev.outside)
+        if c.name == "cone":
+            energy += cut if cone_source == "moments" else s.contour_cut_energy * (1.0 - contour)
+        elif c.name == "ellipsoid":
+            energy += s.noise_energy * (1.0 - clean)
+        energies[c.name] = energy
+    return energies
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_combines_energies_and_back_spread_are_the_former_numpy_values(seed):
+    """Issue 19, stop 65: ``combine``'s log depth ratios by one ``np.log`` of them all, and :func:`fuse_depth`'s
+    spread of the back faces (:func:`_back_spread`) in Python floats: the same energies (float64 scalars, as before),
+    box, weights and uncertainty to the bit as the former one call a candidate, and the same spread as numpy's
+    expression, for 1-9 candidates (8 and more: numpy itself), some without agreement, depths below the floor, tied
+    back faces, weights zero."""
+    from symfruit.core.box import Box
+
+    rng = np.random.default_rng(seed)
+    s = EvidenceSettings()
+    names = ["sphere", "ellipsoid", "cone", "revolution", "outline", "mirror", "raw", "extra1", "extra2"]
+    k = int(rng.integers(1, 10))
+    cands = []
+    for name in names[:k]:
+        lo = rng.normal(0.0, 0.05, 3) + np.array([0.0, 0.0, 0.4])
+        hi = lo + rng.uniform(0.0, 0.08, 3)
+        closed = name not in ("mirror", "raw") and rng.random() < 0.9
+        depth = float(rng.choice([1e-7, rng.uniform(1e-4, 5e-3)]))
+        agreement = Agreement(depth, float(rng.random()), float(rng.random())) if closed else None
+        cands.append(Candidate(name, lo, hi, agreement, 0.5 * (lo + hi), float(rng.uniform(0.0, 0.01))))
+    if k > 2 and rng.random() < 0.5:
+        cands[1] = Candidate(cands[1].name, cands[0].lo.copy(), cands[0].hi.copy(), cands[1].agreement, cands[1].centre)
+    contour, clean = float(rng.random()), float(rng.random())
+    source = str(rng.choice(["moments", "contour"]))
+    got = combine(cands, contour=contour, clean=clean, s=s, cone_source=source)
+    want = _former_energies(cands, contour, clean, s, source)
+    assert list(got.energies) == list(want)
+    for name, energy in want.items():
+        assert type(got.energies[name]) is type(energy) and got.energies[name] == energy
+    # the former weights, spread and uncertainty (np.exp of -(e - min) / t, box.centre, box.size.max())
+    from symfruit.core.points import row_norms
+
+    e = np.array([want[c.name] for c in cands])
+    w_former = np.exp(-(e - e.min()) / s.temperature)
+    w_former /= w_former.sum()
+    assert [got.weights[c.name] for c in cands] == w_former.tolist()
+    faces = np.array([c.lo.tolist() + c.hi.tolist() for c in cands])
+    spread = float((w_former * row_norms(0.5 * (faces[:, :3] + faces[:, 3:]) - got.box.centre)).sum())
+    assert got.spread == spread
+    closed = [c.agreement for c in cands if c.agreement is not None]
+    wrong = min((a.inside + a.outside for a in closed), default=2.0)
+    back_std = next((c.back_std for c in cands if c.name == "cone" and np.isfinite(c.back_std)), 0.0)
+    size = float(got.box.size.max())
+    assert got.uncertainty == float(np.hypot(back_std, spread) + s.misfit_scale * wrong * size)
+    w = np.array([got.weights[c.name] for c in cands])
+    w[rng.random(k) < 0.2] = 0.0
+    weights = dict(zip([c.name for c in cands], w.tolist(), strict=True))
+    fit_back = float(got.box.max[2])
+    backs = np.array([c.hi[2] for c in cands])
+    spread = _back_spread(cands, weights, fit_back)
+    assert type(spread) is float and spread == float((w * np.abs(backs - fit_back)).sum())
+    assert _back_spread([], {}, 0.3) == 0.0
+    two = [Candidate(n, np.zeros(3), np.array([1.0, 1.0, b]), None, np.zeros(3)) for n, b in (("a", 0.5), ("b", 2.0))]
+    assert _back_spread(two, {"a": 0.5, "b": 0.25}, 1.0) == 0.5 * 0.5 + 0.25 * 1.0
+    assert Box(np.zeros(3), np.ones(3)).size.max() == 1.0
 
 
 def test_the_prior_width_reads_the_tilt_when_given():

@@ -50,12 +50,14 @@ def apex_depth(points: np.ndarray, *, share: float = 0.08, min_points: int = 12)
     # by the compiled twins where numba is and the points are C-ordered float64 (the same values; issue 19, stop 45:
     # two calls for fourteen), the partitions numpy's either way (their order of the picked rows is the fit's)
     jit = compiled() if p.dtype == np.float64 and p.flags.c_contiguous else None
+    # (the arrays' own argpartition and argmin: what np.argpartition and np.argmin call, without their dispatch;
+    # issue 19, stop 65, docs/evid65.md)
     if jit is not None:
-        seed, d2 = jit.apex_near(p, np.argpartition(z, front - 1)[:front])
+        seed, d2 = jit.apex_near(p, z.argpartition(front - 1)[:front])
     else:
-        seed = column_means(p[np.argpartition(z, front - 1)[:front], :2])  # .mean(axis=0), the same values
+        seed = column_means(p[z.argpartition(front - 1)[:front], :2])  # .mean(axis=0), the same values
         d2 = squared_norms(p[:, :2] - seed)  # ((...) ** 2).sum(axis=1), the same values
-    pick = np.argpartition(d2, k - 1)[:k]
+    pick = d2.argpartition(k - 1)[:k]
     if jit is not None:
         a, near_z = jit.apex_design(p, pick, seed)
     else:
@@ -71,8 +73,8 @@ def apex_depth(points: np.ndarray, *, share: float = 0.08, min_points: int = 12)
     x, y = a[:, 1], a[:, 2]
     coef, _, _ = lapack.lstsq(a, near_z)  # np.linalg.lstsq(..., rcond=None)'s
     fitted = a @ coef
-    i = int(np.argmin(fitted))
-    best_z, best_xy = float(fitted[i]), np.array([x[i], y[i]])
+    i = int(fitted.argmin())
+    best_z, best_xy = float(fitted[i]), (float(x[i]), float(y[i]))  # Python floats: the same sums below
     c1, c2, c3, c4, c5 = coef[1:].tolist()
     # The Hessian's eigenvalues and the vertex by the closed forms that repeat numpy's eigvalsh and solve bit for bit
     # (core.fits.eigenvalues2 and solve2; numpy where they cannot), not two LAPACK calls of 20-30 us.
@@ -87,8 +89,9 @@ def apex_depth(points: np.ndarray, *, share: float = 0.08, min_points: int = 12)
         if found[0] * found[0] + found[1] * found[1] <= float(d2[pick].max()):  # v @ v: numpy's dot, left to right
             zv = float(np.array([1.0, v[0], v[1], v[0] ** 2, v[0] * v[1], v[1] ** 2]) @ coef)
             if zv < best_z:
-                best_z, best_xy = zv, v
-    return best_z, np.concatenate((best_xy + seed, [best_z]))
+                best_z, best_xy = zv, found  # v's values
+    s0, s1 = seed.tolist()  # the apex, ``np.concatenate((best_xy + seed, [best_z]))``'s values in one array
+    return best_z, np.array([best_xy[0] + s0, best_xy[1] + s1, best_z])
 
 
 def sphere_front(points: np.ndarray, radius: float, *, iterations: int = 20,

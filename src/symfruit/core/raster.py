@@ -1040,7 +1040,8 @@ def outline_circle(
     # the normal equations about the points' mean: f = -mean(z), and a 2 x 2 system for d, e (no least-squares
     # solver: a tenth of the call's cost where the circle is tried on every cut outline without an ellipse)
     try:
-        found = solve2(float(x @ x), float(x @ y), float(x @ y), float(y @ y), -float(x @ z), -float(y @ z))
+        xy = float(x @ y)  # once for both off-diagonal entries (the same product; stop 65)
+        found = solve2(float(x @ x), xy, xy, float(y @ y), -float(x @ z), -float(y @ z))
     except np.linalg.LinAlgError:  # the points on a line
         return None
     if found is None:
@@ -1050,7 +1051,8 @@ def outline_circle(
     if not (math.isfinite(r2) and r2 > 0.0):
         return None
     off = np.sqrt((x - cu) ** 2 + (y - cv) ** 2) - math.sqrt(r2)
-    if not float(np.sqrt((off * off).mean())) <= fit_px:
+    mean_square = float((off * off).mean())  # its root by math.sqrt, np.sqrt's (correctly rounded); NaN: refused
+    if not (mean_square >= 0.0 and math.sqrt(mean_square) <= fit_px):
         return None
     centre = np.array([mu[0] + cu, mu[1] + cv])
     if not _credible(region, centre, np.eye(2) / r2, math.pi * r2, inside, max_area):

@@ -498,15 +498,18 @@ class Combined:
     uncertainty: float
 
 
-def _spread(rows: list[list[float]], w: np.ndarray, box: Box) -> float:
+def _spread(
+    rows: list[list[float]], w: np.ndarray, box: Box, centre: tuple[float, float, float] | None = None
+) -> float:
     """``float((w * row_norms(centres - box.centre)).sum())`` of the candidates' faces ``rows`` (k lists of six
     floats, ``centres`` their ``0.5 * (lo + hi)``): in Python floats where ``k < 8`` (numpy adds so few values left
-    to right; each difference, product and root IEEE's, as numpy's; issue 19, stop 45), else by numpy."""
+    to right; each difference, product and root IEEE's, as numpy's; issue 19, stop 45), else by numpy. ``centre``:
+    ``box.centre.tolist()`` when known (stop 65)."""
     if len(rows) >= 8 or len(rows) != len(w):
         faces = np.array(rows)
         centres = 0.5 * (faces[:, :3] + faces[:, 3:])
         return float((w * row_norms(centres - box.centre)).sum())
-    b0, b1, b2 = box.centre.tolist()
+    b0, b1, b2 = box.centre.tolist() if centre is None else centre
     total = 0.0
     for (l0, l1, l2, h0, h1, h2), wi in zip(rows, w.tolist(), strict=True):
         d0, d1, d2 = 0.5 * (l0 + h0) - b0, 0.5 * (l1 + h1) - b1, 0.5 * (l2 + h2) - b2
@@ -519,7 +522,7 @@ def _weighted_median(values: np.ndarray, weights: np.ndarray, *, listed: list[li
     then the first place where the running sum of the weights in that order (added one by one, as ``np.cumsum``
     adds them) reaches half of their sum (``weights.sum()``'s), in Python floats (the same IEEE sums: a few dozen
     additions, where ``np.cumsum`` and two ``np.take_along_axis`` cost some 60 us; issue 19, nineteenth round)."""
-    order = np.argsort(values, axis=0).tolist()
+    order = values.argsort(axis=0).tolist()  # np.argsort's call
     half = float(0.5 * weights.sum())
     w, v = weights.tolist(), values.tolist() if listed is None else listed  # ``listed``: ``values.tolist()``, known
     out = []
@@ -579,12 +582,15 @@ def combine(cands: list[Candidate], *, contour: float, clean: float, s: Evidence
     energies: dict[str, float] = {}
     best_rms = max(min((c.agreement.depth for c in closed if c.agreement is not None), default=1.0), 1e-6)
     cut = s.cut_energy * (1.0 - contour)
+    # the closed candidates' log depth ratios by one np.log of them all (its float64 values, each the scalar call's;
+    # issue 19, stop 65: one ufunc call for one a candidate), in their order
+    logs = iter(np.log(np.array([max(c.agreement.depth, 1e-6) / best_rms for c in closed if c.agreement is not None])))
     for c in cands:
         ev = c.agreement
         if ev is None:
             energies[c.name] = s.mirror_energy if c.name == "mirror" else s.raw_energy + cut
             continue
-        energy = s.depth_weight * np.log(max(ev.depth, 1e-6) / best_rms)
+        energy = s.depth_weight * next(logs)
         energy += s.silhouette_weight * (ev.inside + ev.outside)
         if c.name == "cone":
             # its premise: the seen outline is the fruit's silhouette (or, fitted to its contour part, that part)
@@ -594,7 +600,7 @@ def combine(cands: list[Candidate], *, contour: float, clean: float, s: Evidence
         energies[c.name] = energy
     names = [c.name for c in cands]
     e = np.array([energies[n] for n in names])
-    w = np.exp(-(e - e.min()) / s.temperature)
+    w = np.exp((e - e.min()) / -s.temperature)  # -(x) / t: x / -t to the bit (rounding is symmetric in sign)
     w /= w.sum()
     # each candidate's six faces as Python floats, the array made of them (the same float64 values as joining its
     # float64 lo and hi; one call for one a candidate; issue 19, stop 45)
@@ -604,10 +610,12 @@ def combine(cands: list[Candidate], *, contour: float, clean: float, s: Evidence
     if s.back_trim < 0.5:  # the back face over the middle of the weight (EvidenceSettings.back_trim)
         box_faces[5] = max(midmean(faces[:, 5], w, s.back_trim), float(box_faces[2]) + 1e-4)
     box = Box(box_faces[:3], box_faces[3:])
-    spread = _spread(rows, w, box)
+    (l0, l1, l2), (h0, h1, h2) = box.min.tolist(), box.max.tolist()
+    # box.centre's (lo + hi) / 2 and box.size's differences in Python floats: the same IEEE operations
+    spread = _spread(rows, w, box, ((l0 + h0) / 2.0, (l1 + h1) / 2.0, (l2 + h2) / 2.0))
     wrong = min((c.agreement.inside + c.agreement.outside for c in closed if c.agreement is not None),
                 default=2.0)  # fmt: skip
-    size = float(box.size.max())
+    size = max(h0 - l0, h1 - l1, h2 - l2)  # float(box.size.max()): the same differences, finite (a Box's)
     back_std = next((c.back_std for c in cands if c.name == "cone" and math.isfinite(c.back_std)), 0.0)
     uncertainty = float(np.hypot(back_std, spread) + s.misfit_scale * wrong * size)
     confidence = float(np.exp(-uncertainty / s.uncertainty_scale))
@@ -717,7 +725,9 @@ def hidden_front(sample: np.ndarray, front: float, width: float, occlusion: Occl
     z, at = sphere_front(sample, 0.5 * diameter, tolerance=FRONT_TOLERANCE)
     if not (np.isfinite(z) and 0.0 < z < front):
         return front
-    u, v = camera.project(at[None, :])[0]
+    ax, ay, az = at.tolist()  # camera.project's (u, v) of ``at`` in Python floats: the same products and sums
+    inv_z = 1.0 / az  # (z > 0 here)
+    u, v = camera.fx * ax * inv_z + camera.cx, camera.fy * ay * inv_z + camera.cy
     uu, vv = np.array([u]), np.array([v])
     if bool(occlusion.at(uu, vv)[0]):
         return front if float(occlusion.depth_at(uu, vv)[0]) > z else z  # seen behind it there: the fruit would be
@@ -865,11 +875,8 @@ def fuse_depth(
     points is as narrow as the cap it saw, and the silhouette is the better measure of the fruit's width too.
     """
     box = combined.box
-    names = [c.name for c in cands]
-    w = np.array([combined.weights[n] for n in names])
-    backs = np.array([c.hi[2] for c in cands])
     fit_back = float(box.max[2])
-    spread = float((w * np.abs(backs - fit_back)).sum())
+    spread = _back_spread(cands, combined.weights, fit_back)
     back_std = next((c.back_std for c in cands if c.name == "cone" and math.isfinite(c.back_std)), 0.0)
     across = across_sight(region, camera) if across is None else across
     width = float(prior_width(across, combined.contour, s.cut_width, tilt, s.prior_tilt == "prolate", s.tilt_floor,
@@ -938,6 +945,22 @@ def fuse_depth(
         widest = max(across.major, across.minor, *(across.hi - across.lo).tolist())
     lo, hi = _lateral_faces(box, sil, front, back, share, pull, widest)
     return Box(np.array(lo), np.array(hi)), 1.0 / math.sqrt(a + b), width
+
+
+def _back_spread(cands: list[Candidate], weights: dict[str, float], fit_back: float) -> float:
+    """``float((w * np.abs(backs - fit_back)).sum())`` of the candidates' weights ``w`` (``weights`` by name) and back
+    faces ``backs`` (``c.hi[2]``): in Python floats where there are fewer than 8 (numpy adds so few values left to
+    right from the first; each difference, absolute value and product IEEE's, as numpy's; issue 19, stop 65: seven
+    numpy calls a fruit), else by numpy."""
+    if len(cands) >= 8 or not cands:
+        w = np.array([weights[c.name] for c in cands])
+        backs = np.array([c.hi[2] for c in cands])
+        return float((w * np.abs(backs - fit_back)).sum())
+    terms = [weights[c.name] * abs(float(c.hi[2]) - fit_back) for c in cands]
+    total = terms[0]
+    for term in terms[1:]:
+        total += term
+    return total
 
 
 def _lateral_faces(box: Box, across: Across, front: float, back: float, share: float, grow: float,
@@ -1102,7 +1125,9 @@ def evidence(
     # mirrors; an elongated outline leaves the tilt of the fruit's long axis out of the image unseen. (A
     # sparse cloud's points need not end at the rim: no receding measure there.)
     recede = obs.contour * max(0.0, seen_back - float(box.min[2]) - 0.5 * width) if dense else 0.0
-    elongation = float(np.sqrt(across.major / max(across.minor, 1e-12)))
+    stretched = float(across.major / max(across.minor, 1e-12))
+    # np.sqrt's value: both square roots correctly rounded (numpy's where the ratio is NaN or negative)
+    elongation = math.sqrt(stretched) if stretched >= 0.0 else float(np.sqrt(stretched))
     # What no closed shape explains of the seen depths beyond the sensor's noise: a shape that misses the front
     # it was fitted to does not predict the back it extrapolates (the outline's part is in ``combined``). Not for
     # a sparse cloud, whose points need not be the nearest surface on their rays.
