@@ -4388,15 +4388,7 @@ def _band_walk(cand: np.ndarray, mine: np.ndarray, count: int, band: int, hidden
     for r in range(m):
         for c in range(n):
             if cand[r, c]:
-                for dr in range(-1, 2):
-                    rr = r + dr
-                    if 0 <= rr < m:
-                        for dc in range(-1, 2):
-                            cc = c + dc
-                            if 0 <= cc < n and mine[rr, cc] and not reached[r, c]:
-                                reached[r, c] = True
-                                queue[end] = r * n + c
-                                end += 1
+                end = _band_first(mine, reached, queue, end, r, c)
     return _band_spread(cand, queue, end, reached, band, hidden, b0, a0, reach)
 
 
@@ -4414,16 +4406,26 @@ def _band_walk_listed(cand: np.ndarray, mine: np.ndarray, count: int, band: int,
         p = at[i]
         r, c = p // n, p - (p // n) * n
         if cand[r, c]:
-            for dr in range(-1, 2):
-                rr = r + dr
-                if 0 <= rr < m:
-                    for dc in range(-1, 2):
-                        cc = c + dc
-                        if 0 <= cc < n and mine[rr, cc] and not reached[r, c]:
-                            reached[r, c] = True
-                            queue[end] = r * n + c
-                            end += 1
+            end = _band_first(mine, reached, queue, end, r, c)
     return _band_spread(cand, queue, end, reached, band, hidden, b0, a0, reach)
+
+
+@_njit_inlined
+def _band_first(mine: np.ndarray, reached: np.ndarray, queue: np.ndarray, end: int, r: int, c: int) -> int:
+    """The band walk's first step at the candidate ``(r, c)``: queued (its flat index at ``queue[end]``) and marked
+    ``reached`` where one of its eight neighbours or itself is the fruit's own (``mine``) and it is not yet; the
+    queue's new end (:func:`_band_walk`, :func:`_band_walk_listed`)."""
+    m, n = mine.shape
+    for dr in range(-1, 2):
+        rr = r + dr
+        if 0 <= rr < m:
+            for dc in range(-1, 2):
+                cc = c + dc
+                if 0 <= cc < n and mine[rr, cc] and not reached[r, c]:
+                    reached[r, c] = True
+                    queue[end] = r * n + c
+                    end += 1
+    return end
 
 
 @_njit_inlined
