@@ -9112,3 +9112,33 @@ def test_a_solid_of_revolution_of_points_not_all_finite_is_that_of_the_finite_on
         assert got.cost == want.cost
     with pytest.raises(InputError):
         fit(np.vstack([points[:19], spoilt[40:41]]))
+
+
+# --- stop 65 (glue65): outline_circle's elementwise glue ---------------------------------------------------
+
+
+@pytest.mark.parametrize("n", [3, 7, 8, 9, 60, 129, 300, 1031])
+def test_circle_design_and_mean_square_are_numpys_expressions_to_the_bit(n):
+    """:func:`_jit.circle_design` and :func:`_jit.circle_mean_square` give the values of the numpy expressions they
+    replace in :func:`~symfruit.core.raster.outline_circle` bit for bit: the points about their mean, ``z`` and its
+    mean, the mean squared distance from the circle (numpy's pairwise sums: more than 8 and more than 128 values
+    take its other branches; a sum left to right differs from 9 values on)."""
+    rng = np.random.default_rng(n)
+    for _ in range(20):
+        centre = rng.uniform(-300.0, 900.0, size=2)
+        t = rng.uniform(0.0, rng.uniform(0.5, 2.0 * np.pi), size=n)
+        r = rng.uniform(3.0, 200.0)
+        pts = np.column_stack((centre[0] + r * np.cos(t), centre[1] + r * np.sin(t)))
+        pts = np.round(pts + rng.normal(scale=rng.uniform(0.0, 2.0), size=pts.shape)) + 0.5 * rng.integers(
+            0, 2, pts.shape
+        )
+        mu, x, y, z, z_mean = _jit.circle_design(pts)
+        mu0 = pts.mean(axis=0)
+        x0, y0 = pts[:, 0] - mu0[0], pts[:, 1] - mu0[1]
+        z0 = x0 * x0 + y0 * y0
+        for got, want in ((mu, mu0), (x, x0), (y, y0), (z, z0)):
+            assert got.tobytes() == want.tobytes()
+        assert z_mean == float(z0.mean())
+        cu, cv, rr = rng.normal(scale=3.0), rng.normal(scale=3.0), r * rng.uniform(0.8, 1.2)
+        off = np.sqrt((x0 - cu) ** 2 + (y0 - cv) ** 2) - rr
+        assert _jit.circle_mean_square(x, y, cu, cv, rr) == float((off * off).mean())

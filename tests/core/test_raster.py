@@ -994,3 +994,155 @@ def test_covariance_is_numpys_cov_to_the_bit(n, k, seed, scale, transposed):
     got, want = _covariance(m), np.cov(m)
     assert got.shape == want.shape == (k, k)
     assert got.tobytes() == want.tobytes()
+
+
+# --- stop 65, glue65: free_side_reach's 2x2 algebra in closed forms, its free shares as counts; the pixel count once
+
+
+def _former_free_side_reach(cracks, free, cone, camera, region=None, *, tie_px=1.0):
+    """:func:`free_side_reach` before stop 65 (glue65): LAPACK's eigvalsh and solve, ``ok[at].mean() > 0.5``, the
+    quadratic form read twice."""
+    import math
+
+    from symfruit.core import lapack
+    from symfruit.core.raster import _covariance
+
+    pts = np.asarray(cracks, dtype=np.float64)
+    ok = np.asarray(free, dtype=bool)
+    if len(pts) < 3 or ok.all() or not ok.any():
+        return 1.0, None
+    inv_k = lapack.inv(camera.matrix)
+    conic = inv_k.T @ np.asarray(cone, dtype=np.float64) @ inv_k
+    a, b = conic[:2, :2], conic[:2, 2]
+    eig = lapack.eigvalsh(a)
+    if not np.isfinite(conic).all() or eig[0] <= 0.0:
+        return 1.0, None
+    centre = -lapack.solve(a, b)
+    k = float(centre @ a @ centre - conic[2, 2])
+    if not k > 0.0:
+        return 1.0, None
+    if region is not None:
+        cu, cv = round(float(centre[0])) - region.u0, round(float(centre[1])) - region.v0
+        h, w = region.mask.shape
+        if not (0 <= cu < w and 0 <= cv < h and region.mask[cv, cu]):
+            return 1.0, None
+    a_inv = lapack.inv(a)
+    _, axes = lapack.eigh(_covariance(pts.T))
+    stretch = 1.0
+    projs = [pts @ e for e in axes.T]
+    spans = [(float(proj.min()), float(proj.max())) for proj in projs]
+    widest = max(hi - lo for lo, hi in spans)
+    ends = []
+    for e, proj, (lo, hi) in zip(axes.T, projs, spans, strict=True):
+        reach = math.sqrt(k * float(e @ a_inv @ e))
+        mid = float(centre @ e)
+        at_lo, at_hi = proj <= lo + tie_px, proj >= hi - tie_px
+        new_lo = lo if ok[at_lo].mean() > 0.5 else min(lo, mid - reach)
+        new_hi = hi if ok[at_hi].mean() > 0.5 else max(hi, mid + reach)
+        if hi > lo:
+            length = max(min(new_hi - new_lo, widest), hi - lo)
+            stretch *= length / (hi - lo)
+            grown = (new_hi - new_lo) - (hi - lo)
+            keep = (length - (hi - lo)) / grown if grown > 0.0 else 0.0
+            conjugate = (a_inv @ e) / float(e @ a_inv @ e)
+            for side, target in ((lo, lo - keep * (lo - new_lo)), (hi, hi + keep * (new_hi - hi))):
+                if target != side:
+                    ends.append(centre + (target - mid) * conjugate)
+    stretch = math.sqrt(stretch)
+    return stretch, (np.vstack((pts, *ends)) if ends and stretch > 1.0 else None)
+
+
+def test_free_side_reach_is_the_former_functions_to_the_bit():
+    """Stop 65 (docs/glue65.md): the 2x2 eigenvalues and centre by :func:`eigenvalues2` and :func:`solve2`, the free
+    share of each extreme as counts (``2 s > n``), the quadratic form ``e^T A^-1 e`` once: the stretch and the outline
+    the former function gave, bytes equal, on 400 seeded cut ellipses (oblique, off-centre, fitted too large or too
+    small), their outlines' free labels drawn so that ties (exactly half the extreme free) occur."""
+    from symfruit.core.raster import Silhouette, free_side_reach, outline_cracks
+
+    rng = np.random.default_rng(65)
+    cam = Camera(fx=600.0, fy=610.0, cx=63.3, cy=47.9, width=128, height=96)
+    v, u = np.mgrid[:96, :128]
+    moved = ties = 0
+    for _ in range(400):
+        cu, cv = rng.uniform(40.0, 88.0), rng.uniform(35.0, 61.0)
+        ra, rb, th = rng.uniform(6.0, 25.0), rng.uniform(6.0, 25.0), rng.uniform(0.0, np.pi)
+        c, s = np.cos(th), np.sin(th)
+        du, dv = u - cu, v - cv
+        mask = ((c * du + s * dv) / ra) ** 2 + ((-s * du + c * dv) / rb) ** 2 <= 1.0
+        cut = rng.uniform(-1.0, 1.0, size=2)
+        mask &= cut[0] * du + cut[1] * dv <= rng.uniform(0.0, 0.8) * max(ra, rb) * np.hypot(*cut)
+        if mask.sum() < 10:
+            continue
+        region = Silhouette(0, 0, mask, 0.0)
+        cracks = outline_cracks(region)
+        free = rng.random(len(cracks)) < rng.uniform(0.2, 0.9)
+        # the fitted ellipse: the fruit's, grown or shrunk, shifted a little
+        grow = rng.uniform(0.7, 1.4)
+        r1, r2 = ra * grow, rb * grow * rng.uniform(0.9, 1.1)
+        rot = np.array([[c, s], [-s, c]])
+        a2 = rot.T @ np.diag([1.0 / r1**2, 1.0 / r2**2]) @ rot
+        ctr = np.array([cu, cv]) + rng.normal(scale=1.0, size=2)
+        conic = np.block([[a2, (-a2 @ ctr)[:, None]], [(-a2 @ ctr)[None, :], np.array([[ctr @ a2 @ ctr - 1.0]])]])
+        cone = cam.matrix.T @ conic @ cam.matrix
+        for reg in (region, None):
+            got, want = free_side_reach(cracks, free, cone, cam, reg), _former_free_side_reach(cracks, free, cone, cam,
+                                                                                             reg)  # fmt: skip
+            assert got[0] == want[0]
+            assert (got[1] is None) == (want[1] is None)
+            if got[1] is not None:
+                assert got[1].tobytes() == want[1].tobytes()
+                moved += 1
+        _, axes = np.linalg.eigh(np.cov(cracks.T))
+        for e in axes.T:
+            proj = cracks @ e
+            for at in (proj <= proj.min() + 1.0, proj >= proj.max() - 1.0):
+                ties += 2 * np.count_nonzero(free[at]) == np.count_nonzero(at)
+    assert moved > 200 and ties > 20
+
+
+def test_a_regions_pixels_are_counted_once_and_are_the_masks_count():
+    """Stop 65: :func:`pixel_count` is ``np.count_nonzero`` of the mask, kept with the region; :func:`rim_width` of a
+    region is its mask's."""
+    from symfruit.core.raster import Silhouette, pixel_count
+    from symfruit.methods.evidence import rim_width
+
+    rng = np.random.default_rng(7)
+    for _ in range(20):
+        mask = rng.random((int(rng.integers(1, 60)), int(rng.integers(1, 60)))) < rng.uniform(0.0, 1.0)
+        region = Silhouette(3, 4, mask, 0.0)
+        assert pixel_count(region) == np.count_nonzero(mask) == region._made["pixels"]
+        assert pixel_count(region) is region._made["pixels"]
+        for band in (0.15, 0.5, 2.0):
+            assert rim_width(region, band) == rim_width(mask, band) == max(2.0, band * np.sqrt(mask.sum() / np.pi))
+
+
+def test_outline_circle_is_the_same_cone_with_the_kernels_and_the_twins(monkeypatch):
+    """Stop 65 (docs/glue65.md): :func:`outline_circle` with its two compiled steps (the points about their mean, the
+    mean squared distance from the circle) and with the numpy expressions they replace: the same cone and axis, bytes
+    equal, or None alike, on 300 seeded cut discs with noisy outlines (some refused as ragged)."""
+    from symfruit.core.raster import Silhouette, outline_circle, outline_cracks
+
+    pytest.importorskip("numba")
+    rng = np.random.default_rng(650)
+    cam = Camera(fx=600.0, fy=610.0, cx=63.3, cy=47.9, width=128, height=96)
+    v, u = np.mgrid[:96, :128]
+    found = refused = 0
+    for _ in range(300):
+        cu, cv, r = rng.uniform(40.0, 88.0), rng.uniform(35.0, 61.0), rng.uniform(8.0, 30.0)
+        mask = (u - cu) ** 2 + (v - cv) ** 2 <= r * r
+        mask &= u >= cu - r + rng.uniform(0.3, 1.2) * r
+        region = Silhouette(0, 0, mask, 0.0)
+        cracks = outline_cracks(region)
+        free = cracks[:, 0] > cu - r + rng.uniform(0.3, 1.2) * r + 0.6
+        pts = cracks[free] + rng.normal(scale=rng.uniform(0.0, 0.6), size=(int(free.sum()), 2))
+        got = outline_circle(region, cam, pts)
+        monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
+        want = outline_circle(region, cam, pts)
+        monkeypatch.delenv("SYMFRUIT_KERNELS")
+        assert (got is None) == (want is None)
+        if got is None:
+            refused += 1
+            continue
+        found += 1
+        assert got[0].tobytes() == want[0].tobytes() and got[1].tobytes() == want[1].tobytes()
+    assert found > 100 and refused > 20

@@ -41,6 +41,7 @@ from .raster import (
     outer_distance,
     outline_cone,
     outline_cracks,
+    pixel_count,
     silhouette_cone,
 )
 
@@ -300,7 +301,7 @@ def observe(
             inner, outer = distance_maps(mask, reach, out_reach)
         depth_px = _inside_px(points, region, camera, inner)
         edge_px = depth_px if dense is None else _inside_px(edge_points, region, camera, inner, dense_pixels)
-        if len(edge_points) >= 0.5 * np.count_nonzero(mask):  # about a point per pixel: neighbours from the image grid
+        if len(edge_points) >= 0.5 * pixel_count(region):  # about a point per pixel: neighbours from the image grid
             edge_uv, is_contour = _contour_pixels(edge_points, edge_px, region, camera, contour_points)
         else:
             edge_uv, is_contour = _contour_points(edge_points, edge_px, camera, contour_points)

@@ -834,10 +834,16 @@ def free_side_reach(
     inv_k = lapack.inv(camera.matrix)
     conic = inv_k.T @ np.asarray(cone, dtype=np.float64) @ inv_k  # the ellipse in pixels, negative inside
     a, b = conic[:2, :2], conic[:2, 2]
-    eig = lapack.eigvalsh(a)
+    # numpy's eigvalsh and solve of the 2x2 block by the closed forms that repeat LAPACK's values bit for bit where
+    # they can (core.fits.eigenvalues2, solve2; None: ask LAPACK), as outline_cone does (stop 65, docs/glue65.md)
+    (a00, a01, b0), (a10, a11, b1), _ = conic.tolist()
+    eig = eigenvalues2(a00, a10, a11)  # eigvalsh reads the lower triangle
+    if eig is None:
+        eig = tuple(lapack.eigvalsh(a).tolist())
     if not np.isfinite(conic).all() or eig[0] <= 0.0:
         return 1.0, None
-    centre = -lapack.solve(a, b)
+    found = solve2(a00, a01, a10, a11, b0, b1)  # raises LinAlgError where LAPACK does
+    centre = np.array([-found[0], -found[1]]) if found is not None else -lapack.solve(a, b)
     k = float(centre @ a @ centre - conic[2, 2])
     if not k > 0.0:
         return 1.0, None
@@ -854,23 +860,35 @@ def free_side_reach(
     widest = max(hi - lo for lo, hi in spans)  # np.ptp's max less min
     ends = []
     for e, proj, (lo, hi) in zip(axes.T, projs, spans, strict=True):
-        reach = math.sqrt(k * float(e @ a_inv @ e))  # the ellipse's half extent along e
+        q = float(e @ a_inv @ e)  # once for the reach and the conjugate diameter (the same product; stop 65)
+        reach = math.sqrt(k * q)  # the ellipse's half extent along e
         mid = float(centre @ e)
-        at_lo, at_hi = proj <= lo + tie_px, proj >= hi - tie_px
-        new_lo = lo if ok[at_lo].mean() > 0.5 else min(lo, mid - reach)
-        new_hi = hi if ok[at_hi].mean() > 0.5 else max(hi, mid + reach)
+        # most of the extreme outline free: ok[at].mean() > 0.5, as counts (2 s > n: s / n rounds above 0.5)
+        free_lo, free_hi = ok[proj <= lo + tie_px], ok[proj >= hi - tie_px]
+        new_lo = lo if 2 * np.count_nonzero(free_lo) > len(free_lo) else min(lo, mid - reach)
+        new_hi = hi if 2 * np.count_nonzero(free_hi) > len(free_hi) else max(hi, mid + reach)
         if hi > lo:
             length = max(min(new_hi - new_lo, widest), hi - lo)
             stretch *= length / (hi - lo)
             grown = (new_hi - new_lo) - (hi - lo)
             keep = (length - (hi - lo)) / grown if grown > 0.0 else 0.0  # the capped extra length, shared
             # the ellipse's extreme points along e are centre +- reach * conjugate (projections mid +- reach)
-            conjugate = (a_inv @ e) / float(e @ a_inv @ e)
+            conjugate = (a_inv @ e) / q
             for side, target in ((lo, lo - keep * (lo - new_lo)), (hi, hi + keep * (new_hi - hi))):
                 if target != side:
                     ends.append(centre + (target - mid) * conjugate)
     stretch = math.sqrt(stretch)
     return stretch, (np.vstack((pts, *ends)) if ends and stretch > 1.0 else None)
+
+
+def pixel_count(region: Silhouette) -> int:
+    """``np.count_nonzero(region.mask)``, counted once per region (:func:`~symfruit.core.agreement.observe`,
+    :func:`~symfruit.methods.evidence.rim_width` and ``evidence`` each read it: the same region's pixels were counted
+    up to four times a fruit; stop 65, docs/glue65.md)."""
+    found = region._made.get("pixels")
+    if found is None:
+        found = region._made["pixels"] = int(np.count_nonzero(region.mask))
+    return found
 
 
 def outline_cracks(region: Silhouette) -> np.ndarray:
@@ -1034,9 +1052,13 @@ def outline_circle(
         raise InputError(f"outline points must have shape (m, 2), got {pts.shape}")
     if len(pts) < max(min_points, 3):
         return None
-    mu = column_means(pts)
-    x, y = pts[:, 0] - mu[0], pts[:, 1] - mu[1]
-    z = x * x + y * y
+    if (jit := compiled()) is not None:  # the compiled twin of the three lines below and z.mean(): the same values
+        mu, x, y, z, z_mean = jit.circle_design(np.ascontiguousarray(pts))
+    else:
+        mu = column_means(pts)
+        x, y = pts[:, 0] - mu[0], pts[:, 1] - mu[1]
+        z = x * x + y * y
+        z_mean = float(z.mean())
     # the normal equations about the points' mean: f = -mean(z), and a 2 x 2 system for d, e (no least-squares
     # solver: a tenth of the call's cost where the circle is tried on every cut outline without an ellipse)
     try:
@@ -1047,11 +1069,15 @@ def outline_circle(
     if found is None:
         return None
     cu, cv = -0.5 * found[0], -0.5 * found[1]
-    r2 = cu * cu + cv * cv + float(z.mean())
+    r2 = cu * cu + cv * cv + z_mean
     if not (math.isfinite(r2) and r2 > 0.0):
         return None
-    off = np.sqrt((x - cu) ** 2 + (y - cv) ** 2) - math.sqrt(r2)
-    mean_square = float((off * off).mean())  # its root by math.sqrt, np.sqrt's (correctly rounded); NaN: refused
+    if jit is not None:  # the compiled twin of the two lines below (stop 65, docs/glue65.md)
+        mean_square = float(jit.circle_mean_square(x, y, cu, cv, math.sqrt(r2)))
+    else:
+        off = np.sqrt((x - cu) ** 2 + (y - cv) ** 2) - math.sqrt(r2)
+        mean_square = float((off * off).mean())
+    # its root by math.sqrt, np.sqrt's (correctly rounded); NaN: refused
     if not (mean_square >= 0.0 and math.sqrt(mean_square) <= fit_px):
         return None
     centre = np.array([mu[0] + cu, mu[1] + cv])
