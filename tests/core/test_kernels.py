@@ -220,6 +220,85 @@ def test_revolution_profile_is_the_twins(seed, n, noise):
     assert fast[3] == pytest.approx(twin[3], rel=1e-6, abs=1e-18)
 
 
+def _revolution_steps_fused(w, which, cnt, a2, steps):
+    """The kernel's Gauss-Newton as it was until stop 65 (each point's distance and its slices' sums in one loop),
+    in Python floats: the values the kernel's split loops (rev65) must give to the bit."""
+    n, b = len(w), len(cnt)
+    w, which, cnt = w.tolist(), which.tolist(), cnt.tolist()
+    for _ in range(steps):
+        sums = [[0.0] * b for _ in range(3)]
+        rho, j0, j1 = [0.0] * n, [0.0] * n, [0.0] * n
+        for i in range(n):
+            d0, d1 = w[i][0] - a2[0], w[i][1] - a2[1]
+            r = max(math.sqrt(d0 * d0 + d1 * d1), 1e-12)
+            rho[i], j0[i], j1[i] = r, -d0 / r, -d1 / r
+            s = which[i]
+            sums[0][s] += r
+            sums[1][s] += j0[i]
+            sums[2][s] += j1[i]
+        means = [[sums[k][s] / cnt[s] for s in range(b)] for k in range(3)]
+        a11 = a12 = a22 = g0 = g1 = 0.0
+        for i in range(n):
+            s = which[i]
+            res, x0, x1 = rho[i] - means[0][s], j0[i] - means[1][s], j1[i] - means[2][s]
+            a11 += x0 * x0
+            a12 += x0 * x1
+            a22 += x1 * x1
+            g0 -= x0 * res
+            g1 -= x1 * res
+        if abs(a11 * a22 - a12 * a12) < 1e-30:
+            break
+        step = np.empty(2)
+        if not _jit.solve(np.array([[a11, a12], [a12, a22]]), np.array([g0, g1]), step):
+            break
+        a2[0] += step[0]
+        a2[1] += step[1]
+        if max(abs(step[0]), abs(step[1])) < 1e-7:
+            break
+
+
+@settings(max_examples=150)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 300), st.integers(1, 16), st.integers(0, 6))
+def test_the_revolution_steps_kernel_is_its_fused_loop_to_the_bit(seed, n, bins, steps):
+    """rev65 split the kernel's Gauss-Newton loop (the distances, then the slices' sums): the same axis position,
+    bit for bit, as the former fused loop, for points about an axis off the start, slices some of them empty, and
+    a start on a point (its distance taken as 1e-12)."""
+    rng = np.random.default_rng(seed)
+    phi = rng.uniform(-np.pi, np.pi, n)
+    w = np.c_[np.cos(phi), np.sin(phi)] * rng.uniform(0.01, 0.04, (n, 1)) + rng.normal(scale=0.003, size=(n, 2))
+    which = rng.integers(0, bins, n)
+    cnt = np.maximum(np.bincount(which, minlength=bins), 1).astype(np.float64)
+    start = w[0].copy() if seed % 5 == 0 else rng.normal(scale=0.005, size=2)
+    fast, slow = start.copy(), start.tolist()
+    _jit.revolution_steps(w, which, cnt, fast, steps)
+    _revolution_steps_fused(w, which, cnt, slow, steps)
+    assert fast.tobytes() == np.array(slow).tobytes()
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(20, 400))
+def test_the_revolution_profile_kernels_radii_are_the_fused_loops(seed, n):
+    """The profile's radii (each slice's mean distance from the axis it found, the distances worked out apart from
+    their sums since rev65) to the bit: the distances from the axis and their sums in the points' order, in Python
+    floats, from the kernel's own plane coordinates and slices."""
+    rng = np.random.default_rng(seed)
+    phi, h = rng.uniform(-1.2, 1.2, n), rng.uniform(-0.03, 0.03, n)
+    q = np.c_[0.03 * np.sin(phi), h, -0.03 * np.cos(phi)] + rng.normal(scale=0.002, size=(n, 3))
+    q -= q.mean(axis=0)
+    best, e1, e2 = np.array([0.0, 1.0, 0.0]), np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0])
+    a2, edges, radii, _, ok = _jit.revolution_profile(q, best, e1, e2, 16, 5)
+    assert ok
+    t = q @ best
+    which = np.clip(np.searchsorted(edges, t, side="right") - 1, 0, 15).tolist()
+    total, count = [0.0] * 16, [0] * 16
+    for p, s in zip(q.tolist(), which, strict=True):
+        u, v = p[0] * e1[0] + p[1] * e1[1] + p[2] * e1[2], p[0] * e2[0] + p[1] * e2[1] + p[2] * e2[2]
+        d0, d1 = u - a2[0], v - a2[1]
+        total[s] += math.sqrt(d0 * d0 + d1 * d1)
+        count[s] += 1
+    want = [total[s] / max(count[s], 1) if count[s] >= 3 else math.nan for s in range(16)]
+    assert radii.tobytes() == np.array(want).tobytes()
+
+
 def test_revolution_profile_of_points_on_a_line_leaves_it_to_the_twin():
     """Every point on the axis: the algebraic start's 2x2 system is singular; the kernel says so (the twin's
     least squares takes its minimum-norm solution) and fit_revolution_slices runs the twin."""
