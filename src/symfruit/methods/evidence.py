@@ -809,7 +809,7 @@ def lost_rim(region: Silhouette, grazing: float, camera: Camera | None = None, *
     >>> (g.u0, g.v0, int(np.count_nonzero(g.mask)) > int(np.count_nonzero(m)))
     (98, 48, True)
     """
-    r = math.sqrt(np.count_nonzero(region.mask) / math.pi)
+    r = math.sqrt(pixel_count(region) / math.pi)  # the region's count, made once (raster.pixel_count)
     grow = max(r * (1.0 / math.sqrt(1.0 - grazing * grazing) - 1.0), least)
     px = math.ceil(grow)
     if grow < 0.5:
